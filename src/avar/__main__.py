@@ -1,0 +1,7 @@
+"""``python -m avar``: the command line."""
+
+import sys
+
+from avar.cli import main
+
+sys.exit(main())
