@@ -77,3 +77,4 @@ def test_many_levels_use_level_wise_path_with_same_values():
     every = averaging_factors(600, taus="all")  # more than FUSED_MAX_LEVELS levels
     assert every.size > _kernels.FUSED_MAX_LEVELS
     np.testing.assert_allclose(allan_variance_columns(x, every, "mo"), numpy_twin(x, every, "mo"), rtol=1e-12)
+

@@ -46,8 +46,9 @@ CHUNK = 1 << 15
 #: Samples per block of the parallel cumulative sum.
 CUMSUM_BLOCK = 1 << 16
 
-#: Differences per time block when all "mo" levels are fused.
-FUSED_BLOCK = 4096
+#: Differences per time block when all "mo" levels are fused: the window
+#: ends of the smaller levels stay in the caches across the block.
+FUSED_BLOCK = 1 << 16
 
 #: Grids with more levels than this (such as taus="all") go level by level:
 #: their per-level work is large and the fused per-block table would be too.
@@ -241,6 +242,19 @@ def task_sums(hi, lo, task_channel, task_factor, task_stride, task_first, task_l
     return out
 
 
+def _level_wise_sums(hi, lo, channels, factors, strides, n_differences, chunk):
+    """Sums of (channel, level) pairs, each split into tasks of ``chunk`` differences."""
+    per_pair = -(-n_differences // chunk)
+    pair_of_task = np.repeat(np.arange(channels.shape[0]), per_pair)
+    pair_start = np.concatenate(([0], np.cumsum(per_pair)[:-1]))
+    first = (np.arange(pair_of_task.shape[0]) - pair_start[pair_of_task]) * chunk
+    last = np.minimum(first + chunk, n_differences[pair_of_task])
+    sums = task_sums(
+        hi, lo, channels[pair_of_task], factors[pair_of_task], strides[pair_of_task], first, last
+    )
+    return np.bincount(pair_of_task, weights=sums, minlength=channels.shape[0])
+
+
 def squared_difference_sums(hi, lo, factors, strides, n_differences, chunk=CHUNK):
     """Sum of squared second differences ``D_k**2`` for every channel and level.
 
@@ -261,10 +275,8 @@ def squared_difference_sums(hi, lo, factors, strides, n_differences, chunk=CHUNK
     -----
     Maximal-overlap grids of at most ``FUSED_MAX_LEVELS`` levels go through
     :func:`fused_overlapping_sums`; others (tau overlap, taus="all") through
-    :func:`task_sums`,
-    which splits every (channel, level) into tasks of ``chunk`` differences.
-    Either way the summation order depends only on the block sizes, never on
-    the number of threads.
+    :func:`task_sums`. Either way the summation order depends only on the
+    block sizes, never on the number of threads.
     """
     factors = np.asarray(factors, dtype=np.int64)
     strides = np.asarray(strides, dtype=np.int64)
@@ -273,23 +285,9 @@ def squared_difference_sums(hi, lo, factors, strides, n_differences, chunk=CHUNK
     n_levels = factors.shape[0]
     if np.all(strides == 1) and n_levels <= FUSED_MAX_LEVELS:
         return fused_overlapping_sums(hi, lo, factors, n_differences).sum(axis=1)
-    per_level = -(-n_differences // chunk)
-    level_of_task = np.repeat(np.arange(n_levels), per_level)
-    level_start = np.concatenate(([0], np.cumsum(per_level)[:-1]))
-    first = (np.arange(level_of_task.shape[0]) - level_start[level_of_task]) * chunk
-    last = np.minimum(first + chunk, n_differences[level_of_task])
-    n_tasks = level_of_task.shape[0]
-    channel = np.repeat(np.arange(n_channels, dtype=np.int64), n_tasks)
-    sums = task_sums(
-        hi,
-        lo,
-        channel,
-        np.tile(factors[level_of_task], n_channels),
-        np.tile(strides[level_of_task], n_channels),
-        np.tile(first, n_channels),
-        np.tile(last, n_channels),
-    )
-    owner = channel * n_levels + np.tile(level_of_task, n_channels)
-    return np.bincount(owner, weights=sums, minlength=n_channels * n_levels).reshape(
-        n_channels, n_levels
-    )
+    channel = np.repeat(np.arange(n_channels, dtype=np.int64), n_levels)
+    level = np.tile(np.arange(n_levels), n_channels)
+    sums = _level_wise_sums(hi, lo, channel, factors[level], strides[level], n_differences[level], chunk)
+    return sums.reshape(n_channels, n_levels)
+
+

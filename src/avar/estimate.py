@@ -102,26 +102,39 @@ def averaging_factors(n: int, freq: float = 1.0, taus: Any = "octave") -> np.nda
     return np.unique(factors.astype(np.int64))
 
 
+#: Bytes of cumulative sums (12 per sample and channel) held at once: wide
+#: inputs are processed in batches of channels that reuse one workspace, so
+#: memory stays bounded and fresh pages are faulted in only once.
+CUMSUM_BUDGET = 1 << 28
+
+
 def allan_variance_columns(data: np.ndarray, factors: np.ndarray, type: str) -> np.ndarray:
     """Allan variance of every column of ``data`` at cluster sizes ``factors``.
 
     ``data`` is a finite float64 array of shape (N, C); returns shape (C, L).
     The series are centred on their means and scaled by a power of two before
     the compensated cumulative sums (see :mod:`avar._kernels`), so the result
-    is as exact as the float64 input allows.
+    is as exact as the float64 input allows. Columns are processed in batches
+    that fit ``CUMSUM_BUDGET``; each column's result does not depend on the
+    batching.
     """
-    n = data.shape[0]
+    n, channels = data.shape
     factors = np.asarray(factors, dtype=np.int64)
     centre = data.mean(axis=0)
     span = np.maximum(data.max(axis=0) - centre, centre - data.min(axis=0))
     _, exponent = np.frexp(np.where(span > 0, span, 1.0))
     scale = np.ldexp(1.0, -exponent)
-    hi = np.empty((data.shape[1], n + 1), dtype=np.float64)
-    lo = np.empty((data.shape[1], n + 1), dtype=np.float32)
-    _kernels.centred_cumsum(data, centre, scale, hi, lo)
     strides = factors if type == "to" else np.ones_like(factors)
     counts = n_differences(n, factors, type)
-    sums = _kernels.squared_difference_sums(hi, lo, factors, strides, counts)
+    batch = max(1, min(channels, CUMSUM_BUDGET // (12 * (n + 1))))
+    hi = np.empty((batch, n + 1), dtype=np.float64)
+    lo = np.empty((batch, n + 1), dtype=np.float32)
+    sums = np.empty((channels, factors.shape[0]))
+    for first in range(0, channels, batch):
+        last = min(channels, first + batch)
+        k = last - first
+        _kernels.centred_cumsum(data[:, first:last], centre[first:last], scale[first:last], hi[:k], lo[:k])
+        sums[first:last] = _kernels.squared_difference_sums(hi[:k], lo[:k], factors, strides, counts)
     unscale = np.ldexp(1.0, 2 * exponent)[:, None]
     return sums * unscale / (2.0 * factors.astype(np.float64) ** 2 * counts)
 
