@@ -415,7 +415,17 @@ def avlr(
     B: int = 100,
     alpha: float = 0.05,
     seed: Any = None,
-) -> AvlrResult:
+    *,
+    qn_gyro: Any = None,
+    wn_gyro: Any = None,
+    rw_gyro: Any = None,
+    dr_gyro: Any = None,
+    qn_acc: Any = None,
+    wn_acc: Any = None,
+    rw_acc: Any = None,
+    dr_acc: Any = None,
+    per_axis: bool = False,
+) -> Any:
     """Allan variance linear regression: fit WN, QN, RW and DR on chosen scales.
 
     Each selected process is fitted on its own scales by the fixed-slope
@@ -442,10 +452,17 @@ def avlr(
         1 - confidence level, in (0, 1).
     seed : None, int or numpy.random.Generator
         Seed of the bootstrap simulations.
+    qn_gyro, wn_gyro, rw_gyro, dr_gyro, qn_acc, wn_acc, rw_acc, dr_acc
+        For an :class:`~avar.ImuAllanVariance` (or :class:`~avar.IMU`) ``x``
+        only: the scales of each process of the gyroscopes and the
+        accelerometers; see :func:`avar.imu_avlr.imu_avlr`.
+    per_axis : bool
+        For IMU data only: fit every axis separately instead of jointly.
 
     Returns
     -------
     AvlrResult
+        Or :class:`~avar.ImuAvlrResult` for IMU data.
 
     Notes
     -----
@@ -477,9 +494,22 @@ def avlr(
         Estimate     SD  Lower  Upper
     WN     0.984  0.006  0.972  0.997
     """
-    if isinstance(x, ImuAllanVariance):
-        raise TypeError("x is an ImuAllanVariance; this fit takes one series or one AllanVariance "
-                        "(fit IMU data per sensor type with the IMU AVLR)")
+    imu_selections = {
+        "qn_gyro": qn_gyro, "wn_gyro": wn_gyro, "rw_gyro": rw_gyro, "dr_gyro": dr_gyro,
+        "qn_acc": qn_acc, "wn_acc": wn_acc, "rw_acc": rw_acc, "dr_acc": dr_acc,
+    }
+    from avar.imu import IMU
+
+    if isinstance(x, (ImuAllanVariance, IMU)):
+        if any(v is not None for v in (qn, wn, rw, dr)) or ci:
+            raise ValueError("IMU data take qn_gyro .. dr_acc (and per_axis), not qn/wn/rw/dr; "
+                             "bootstrap intervals (ci=True) are available for single series only")
+        from avar.imu_avlr import imu_avlr
+
+        return imu_avlr(x, per_axis=per_axis, **imu_selections)
+    given = sorted(name for name, value in imu_selections.items() if value is not None)
+    if given or per_axis:
+        raise TypeError(f"{given or ['per_axis']} apply to IMU data only; for one series use qn, wn, rw, dr")
     av = x if isinstance(x, AllanVariance) else allan_variance(x)
     if len(av) < 2:
         raise ValueError(f"x has an Allan variance of {len(av)} level(s); AVLR needs at least 2 levels")
