@@ -84,6 +84,7 @@ def main(argv=None) -> int:
     for t in args.sizes:
         covmat = make_covmat(t, args.phi, args.seed)
         ns = 2 ** np.arange(1, int(np.log2(t)))
+        _check_covmat(covmat)  # warm-up (numba: load or compile the kernel)
         t_check, _ = median_time(lambda: _check_covmat(covmat), args.repeats)
         for name, fast, slow in (("moav", moav, direct_moav), ("noav", noav, direct_noav)):
             fast(ns, covmat)  # warm-up

@@ -118,7 +118,7 @@ def test_random_psd_against_direct_transcription(t, seed):
 
 @pytest.mark.parametrize("t", [2, 7, 64, 151])
 def test_noav_both_algorithms_agree(t):
-    # one scale: direct block sums; all scales at once: diagonal prefix sums
+    # one scale: segment sums per row and scale; many scales: one prefix scan per row
     a = np.random.default_rng(t).standard_normal((t, t))
     covmat = a @ a.T
     ns = np.arange(1, t // 2 + 1)
@@ -255,6 +255,25 @@ def test_bad_covmat(f):
         f(2, "eye")
     with pytest.raises(TypeError, match="covmat must be a square numeric matrix"):
         f(2, np.eye(4, dtype=complex))
+
+
+@pytest.mark.parametrize("f", [moav, noav])
+def test_check_reads_every_entry(f):
+    # the check splits the matrix in 64 x 64 tiles between two tasks (upper rows,
+    # lower rows, and the top-right block from either side): a defect in any region,
+    # on either side of the diagonal, at the edges of tiles, must be found
+    t = 200
+    edges = [0, 1, 63, 64, 127, 128, 150, 191, 192, 199]
+    for i in edges:
+        for j in edges:
+            c = np.eye(t)
+            c[i, j] = np.nan if (i + j) % 2 else -np.inf
+            with pytest.raises(ValueError, match="covmat must be finite"):
+                f(2, c)
+            if i != j:
+                c[i, j] = 1e-6
+                with pytest.raises(ValueError, match="covmat must be symmetric"):
+                    f(2, c)
 
 
 @pytest.mark.parametrize("f", [moav, noav])

@@ -3,25 +3,35 @@
 For a zero-mean process x_1..x_T with covariance matrix C, the theoretical AV at
 averaging factor n is half the variance of the difference of two adjacent n-means,
 averaged over the windows of the estimator (Xu et al. 2017): ``moav`` uses the
-T - 2n + 1 windows starting at 0, 1, ..., T - 2n; ``noav`` the floor(T / (2n))
+W = T - 2n + 1 windows starting at 0, 1, ..., T - 2n; ``noav`` the M = floor(T / (2n))
 disjoint pairs of blocks (window starts 0, 2n, 4n, ...). With w = (-1 x n, +1 x n)
 and C_s the 2n x 2n diagonal block at s, the window variance is w' C_s w / n^2.
 
 Algorithm. R ``avar`` 0.1.3 sums n x n sub-blocks per window: O(T n^2) per scale.
-Here, grouping the entries of C by diagonal d,
+Here the entries of C are grouped by diagonal, c_d(i) = C[i, i + d]:
 
-    sum_s w' C_s w = sum_{d<2n} mult_d sum_{m<2n-d} w_m w_{m+d} sum_s C[s+m, s+m+d]
+    sum_{s<W} w' C_s w = sum_{d<2n} mult_d sum_{m<2n-d} u_d(m) sum_{s<W} c_d(s + m)
 
-(mult_0 = 1, else 2): the inner sum is a difference of prefix sums along diagonal d,
-and u_d(m) = w_m w_{m+d} has at most three constant pieces, so the sum over m is a few
-differences of second-order prefix sums. Prefix tables along the first 2 max(n)
-diagonals cost O(T max(n)) once (O(T^2) for an octave grid); then a scale costs O(n)
-(moav) or O(T) (noav), with no loop over windows.
+(mult_0 = 1, else 2; u_d(m) = w_m w_(m+d)). The inner sum is the whole diagonal, D_d,
+less a head of m and a tail of 2n-1-d-m entries, so with rho_d = sum_m u_d(m) (2n - 3d
+for d < n, d - 2n after) the total is sum_d mult_d [rho_d D_d - sum_{i<2n-1-d} a_d(i)
+(c_d(i) + c_d(T-d-1-i))], where a_d(i) = sum_{m>i} u_d(m) is a tent made of three
+ramps, (2n-1-d-i)_+ - 2 (n-1-i)_+ + 2 (n-1-d-i)_+. Only the diagonal sums and the two
+corners (top-left, plus bottom-right folded onto it) enter, the corners through the
+second-order prefix sums H[x, d] = sum_{i<x} (x - i) F[i, d] of the folded entries F;
+summed along anti-diagonals and rows, H gives three numbers per scale. One pass over C
+(numba, ``avar._kernels.covariance_pass``) checks the matrix (finite, symmetric) and
+gathers D_d and these corner sums for all scales: it reads the T^2 entries once, works
+O(T max(n)), and each scale then costs O(n). NOAV sums, in the same pass, the upper
+triangles of its disjoint blocks row by row (two or three segment sums per row).
 
-Accuracy. Each diagonal is centered on its middle element before the prefix sums
-(then exactly zero for a Toeplitz matrix). A 2-D summed-area table, the textbook O(1)
-block sum, cancels badly on growing covariances (4e-8 relative error for a random walk
-with T = 2000); this float64 scheme gives ~1e-10 there, ~1e-14 on random PSD matrices.
+Accuracy. Each diagonal is centred on its middle element beta_d before any sum, and
+the centring is added back exactly (a constant diagonal contributes
+mult_d rho_d beta_d W): a Toeplitz (stationary) matrix gives the closed form up to
+rounding of that last sum. Relative errors against exact arithmetic are ~1e-13 on a
+random-walk covariance (T = 2000, octave scales; 1e-12 at the largest n; a 2-D
+summed-area table gives 4e-8 there) and <= 3e-13 on random PSD matrices, the largest
+near n = T/2 where one window remains.
 
 Also here: the covariance matrices of the processes of Xu et al. (2017).
 
@@ -40,6 +50,7 @@ from typing import Any
 
 import numpy as np
 
+from avar import _kernels
 from avar.theory import _as_nonnegative, _as_phi, _as_whole
 
 __all__ = ["moav", "noav", "covmat_ar1blocks", "covmat_bi", "covmat_nswn"]
@@ -47,10 +58,12 @@ __all__ = ["moav", "noav", "covmat_ar1blocks", "covmat_bi", "covmat_nswn"]
 # Relative tolerance of the symmetry check, scaled by max |covmat|.
 _SYM_RTOL = 1e-10
 
+_NO_SCALES = np.zeros(0, dtype=np.int64)
+
 
 # --------------------------------------------------------------------------- helpers
-def _check_covmat(covmat: Any) -> np.ndarray:
-    """Validate a finite, square, symmetric real matrix; return it as C-contiguous float64."""
+def _as_covmat(covmat: Any) -> np.ndarray:
+    """A square real matrix (at least 2 x 2) as C-contiguous float64; values unchecked."""
     if covmat is None or isinstance(covmat, (str, bytes)):
         raise TypeError(f"covmat must be a square numeric matrix, got {type(covmat).__name__}")
     c = np.asarray(covmat)
@@ -62,122 +75,51 @@ def _check_covmat(covmat: Any) -> np.ndarray:
     if c.shape[0] < 2:
         raise ValueError(f"covmat must be at least 2 x 2 (T >= 2n with n >= 1), "
                          f"got shape {c.shape}")
-    c = np.ascontiguousarray(c, dtype=np.float64)
-    asym = _asymmetry(c)
-    if not np.isfinite(asym) and not np.isfinite(c).all():
+    return np.ascontiguousarray(c, dtype=np.float64)
+
+
+def _pass(c: np.ndarray, width: int = 0, noav_ns: np.ndarray = _NO_SCALES) -> tuple:
+    """Run the one-pass kernel (check + MOAV sums up to ``width`` = 2 max(n) + NOAV
+    block sums of ``noav_ns``); raise if covmat is not finite or not symmetric."""
+    noav_width = 2 * int(noav_ns.max()) if noav_ns.size else 0
+    # many NOAV scales: one prefix scan per row beats per-scale segment sums
+    scan = bool(2 * int(noav_ns.sum()) > _kernels.NOAV_SCAN_RATIO * noav_width)
+    asym, top, *sums = _kernels.covariance_pass(c, width, noav_ns, scan, noav_width)
+    amax = float(np.int64(top).view(np.float64))  # max |covmat|, inf/NaN if not finite
+    if not np.isfinite(amax):
         raise ValueError("covmat must be finite (no NaN or inf)")
-    if asym > 0 and not asym <= _SYM_RTOL * float(np.abs(c).max()):
+    if asym > 0 and not asym <= _SYM_RTOL * amax:
         raise ValueError(f"covmat must be symmetric: max |covmat - covmat.T| = {asym:.3g} "
                          f"(tolerance {_SYM_RTOL:g} * max |covmat|)")
+    return tuple(sums)
+
+
+def _check_covmat(covmat: Any) -> np.ndarray:
+    """Validate a finite, square, symmetric real matrix; return it as C-contiguous float64."""
+    c = _as_covmat(covmat)
+    _pass(c)
     return c
 
 
-def _asymmetry(c: np.ndarray, rows: int = 128, cols: int = 512) -> float:
-    """max |c - c.T| over cache-sized tiles of the upper triangle; NaN/inf if not finite."""
-    t, worst = c.shape[0], 0.0
-    with np.errstate(invalid="ignore", over="ignore"):
-        for i in range(0, t, rows):
-            for j in range(i, t, cols):
-                diff = float(np.abs(c[i:i + rows, j:j + cols] - c[j:j + cols, i:i + rows].T).max())
-                if not diff <= worst:
-                    worst = diff
-                    if not np.isfinite(diff):
-                        return worst
-    return worst
+def _prepare(n: Any, covmat: Any, kind: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(c, m, ks)``: covmat (shape-checked), the scales as given, the distinct scales."""
+    c = _as_covmat(covmat)
+    try:
+        m = _as_whole(n, "n")
+        big = 2 * m > c.shape[0]
+        if big.any():
+            raise ValueError(f"n must satisfy 1 <= n <= T/2 = {c.shape[0] // 2} for {kind} "
+                             f"(T = {c.shape[0]} is the size of covmat), "
+                             f"got {int(m[big].flat[0])}")
+    except (TypeError, ValueError):
+        _pass(c)  # a bad covmat is reported first
+        raise
+    return c, m, np.unique(m).astype(np.int64)
 
 
-def _cumsum_rows(src: np.ndarray, dst: np.ndarray) -> None:
-    """``dst[r] = src[0] + ... + src[r]`` (dst C-contiguous, may be src), in sequential
-    order but blocked so that each NumPy call adds slabs of rows (np.cumsum is slower)."""
-    r, width = dst.shape
-    b = max(1, int(np.sqrt(r)))
-    nb = r // b
-    sh = src[: nb * b].reshape(nb, b, width)
-    dh = dst[: nb * b].reshape(nb, b, width)  # a view: dst is C-contiguous
-    if dst is not src:
-        dh[:, 0] = sh[:, 0]
-    for k in range(1, b):
-        np.add(dh[:, k - 1], sh[:, k], out=dh[:, k])
-    for k in range(1, nb):
-        np.add(dh[k], dh[k - 1, -1], out=dh[k])
-    for k in range(nb * b, r):
-        np.add(dst[k - 1], src[k], out=dst[k])
-
-
-def _diagonal_prefix(c: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(p, beta)``: ``p[r, d] = sum_{i < r} (c[i, i+d] - beta[d])`` for r <= T - d
-    (later rows hold unused finite values), ``beta[d]`` the middle of diagonal d."""
-    t = c.shape[0]
-    # Row i of this view holds c[i, i:i+width] (diagonals side by side); the entries
-    # with i + d >= T wrap into the next row and are never used.
-    view = np.lib.stride_tricks.as_strided(
-        c.ravel(), shape=(t - 1, width), strides=((t + 1) * c.itemsize, c.itemsize),
-        writeable=False)
-    d = np.arange(width)
-    beta = view[(t - 1 - d) // 2, d]  # middle of the valid part of each diagonal
-    p = np.empty((t + 1, width))
-    p[0] = 0.0
-    np.subtract(view, beta, out=p[1:t])
-    p[t] = 0.0
-    p[t, 0] = c[t - 1, t - 1] - beta[0]
-    body = p[1:]
-    _cumsum_rows(body, body)
-    return p, beta
-
-
-def _pieces(n: int) -> tuple[np.ndarray, ...]:
-    """Split points of u_d(m) = w_m w_(m+d) for d = 0..2n-1 (w = -1 on A, +1 on B).
-
-    u_d = +1 on [0, n1), -1 on [n1, n2), +1 on [n, n3); rho(d) = sum_m u_d(m).
-    """
-    d = np.arange(2 * n)
-    n1 = np.maximum(n - d, 0)
-    n2 = np.minimum(n, 2 * n - d)
-    n3 = np.maximum(n, 2 * n - d)
-    rho = (2 * n1 - n2 + n3 - n).astype(np.float64)
-    mult = np.where(d == 0, 1.0, 2.0)  # (k, l) and (l, k) for d > 0
-    return d, n1, n2, n3, rho, mult
-
-
-def _moav_one(q: np.ndarray, beta: np.ndarray, t: int, n: int) -> float:
-    """``q[r] = PP[r + 1]``, PP[x] = sum_{r < x} P[r] (second-order prefix sums)."""
-    w = t - 2 * n + 1
-    d, n1, n2, n3, rho, mult = _pieces(n)
-
-    def f(x: np.ndarray) -> np.ndarray:  # sum_{m < x} (P[m + W] - P[m])
-        return q[x + w - 1, d] - q[np.maximum(x - 1, 0), d]  # PP[0] = PP[1] = 0
-
-    pieces = 2.0 * f(n1) - f(np.zeros_like(d)) - f(n2) + (f(n3) - f(np.full_like(d, n)))
-    total = np.sum(mult * (pieces + beta[: 2 * n] * (w * rho)))
-    return float(total) / (2.0 * n * n * w)
-
-
-def _noav_one(p: np.ndarray, beta: np.ndarray, t: int, n: int) -> float:
-    m = t // (2 * n)
-    d, n1, n2, n3, rho, mult = _pieces(n)
-    base = (2 * n * np.arange(m))[:, None]
-
-    def g(x: np.ndarray) -> np.ndarray:  # sum_j P[2 n j + x]
-        return p[base + x[None, :], d[None, :]].sum(axis=0)
-
-    pieces = 2.0 * g(n1) - g(np.zeros_like(d)) - g(n2) + (g(n3) - g(np.full_like(d, n)))
-    total = np.sum(mult * (pieces + beta[: 2 * n] * (m * rho)))
-    return float(total) / (2.0 * n * n * m)
-
-
-def _result(values: list[float], m: np.ndarray) -> float | np.ndarray:
-    if m.ndim == 0:
-        return values[0]
-    return np.asarray(values, dtype=np.float64).reshape(m.shape)
-
-
-def _check_n(n: Any, t: int, kind: str) -> np.ndarray:
-    m = _as_whole(n, "n")
-    big = 2 * m > t
-    if big.any():
-        raise ValueError(f"n must satisfy 1 <= n <= T/2 = {t // 2} for {kind} "
-                         f"(T = {t} is the size of covmat), got {int(m[big].flat[0])}")
-    return m
+def _result(ks: np.ndarray, values: np.ndarray, m: np.ndarray) -> float | np.ndarray:
+    out = values[np.searchsorted(ks, m)]
+    return float(out) if m.ndim == 0 else out.astype(np.float64)
 
 
 # --------------------------------------------------------------------------- AV
@@ -211,9 +153,11 @@ def moav(n: Any, covmat: Any) -> float | np.ndarray:
 
     Notes
     -----
-    O(T max(n)) for centered prefix sums along the first 2 max(n) diagonals, then O(n)
-    per scale, against O(T n^2) per scale for R; see the module docstring for the
-    algorithm and its accuracy. Only the upper triangle is read (after the check).
+    One pass over ``covmat`` (numba, two threads) checks it and gathers, for all the
+    scales at once, the sums of its first 2 max(n) diagonals and second-order prefix
+    sums in its two 2 max(n) corners; each scale then costs O(n), against O(T n^2)
+    per scale for R. See the module docstring for the algorithm and its accuracy.
+    Only the upper triangle enters the result (the lower one is only compared to it).
 
     References
     ----------
@@ -227,13 +171,9 @@ def moav(n: Any, covmat: Any) -> float | np.ndarray:
     >>> moav([1, 2, 4], 2.0 * np.eye(16))
     array([2. , 1. , 0.5])
     """
-    c = _check_covmat(covmat)
-    t = c.shape[0]
-    m = _check_n(n, t, "moav")
-    p, beta = _diagonal_prefix(c, 2 * int(m.max()))
-    _cumsum_rows(p, p)  # in place: now p[r] = sum_{x <= r} P[x] = PP[r + 1]
-    vals = [_moav_one(p, beta, t, int(k)) for k in m.ravel()]
-    return _result(vals, m)
+    c, m, ks = _prepare(n, covmat, "moav")
+    beta, dp, q1, q2, rr, _ = _pass(c, width=2 * int(ks[-1]))
+    return _result(ks, _kernels.moav_from_sums(ks, c.shape[0], beta, dp, q1, q2, rr), m)
 
 
 def noav(n: Any, covmat: Any) -> float | np.ndarray:
@@ -258,9 +198,10 @@ def noav(n: Any, covmat: Any) -> float | np.ndarray:
 
     Notes
     -----
-    Sums the M disjoint diagonal blocks directly (strided view, 3 n^2 M reads) or uses
-    the prefix sums of :func:`moav` (O(T max(n)) once, O(T) per scale), whichever is
-    cheaper for the requested scales.
+    Sums the upper triangles of the M disjoint diagonal blocks row by row, in the pass
+    over ``covmat`` that checks it (numba, two threads): for each row and scale, two or
+    three vectorized segment sums (with many scales, one prefix scan per row instead).
+    That is O(n T) per scale, as for R, but without a Python loop over the blocks.
 
     References
     ----------
@@ -274,28 +215,9 @@ def noav(n: Any, covmat: Any) -> float | np.ndarray:
     >>> noav([1, 2], np.diag(np.arange(1.0, 9.0)))   # variance t at time t
     array([4.5 , 2.25])
     """
-    c = _check_covmat(covmat)
-    t = c.shape[0]
-    m = _check_n(n, t, "noav")
-    ks = [int(k) for k in m.ravel()]
-    # direct block sums read <= 2 n T entries: cheaper unless many scales at once
-    direct_cost = sum(4 * k * k * (t // (2 * k)) for k in ks)
-    if direct_cost <= 4 * t * 2 * max(ks) + 10 * t * len(ks):
-        return _result([_noav_direct(c, k) for k in ks], m)
-    p, beta = _diagonal_prefix(c, 2 * max(ks))
-    return _result([_noav_one(p, beta, t, k) for k in ks], m)
-
-
-def _noav_direct(c: np.ndarray, n: int) -> float:
-    """NOAV by summing the disjoint 2n x 2n diagonal blocks (strided view, no copy)."""
-    t, k = c.shape[0], 2 * n
-    m = t // k
-    blocks = np.lib.stride_tricks.as_strided(
-        c, shape=(m, k, k), strides=(k * (t + 1) * c.itemsize, t * c.itemsize, c.itemsize),
-        writeable=False)
-    a, b = blocks[:, :n, :n], blocks[:, n:, n:]
-    total = a.sum() + b.sum() - 2.0 * blocks[:, :n, n:].sum()
-    return float(total) / (2.0 * n * n * m)
+    c, m, ks = _prepare(n, covmat, "noav")
+    *_, block_sums = _pass(c, noav_ns=ks)
+    return _result(ks, block_sums / (2.0 * ks * ks * (c.shape[0] // (2 * ks))), m)
 
 
 # --------------------------------------------------------------------------- covmats

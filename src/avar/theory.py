@@ -99,6 +99,14 @@ def _broadcast(*arrays: np.ndarray, names: tuple[str, ...]) -> None:
         raise ValueError(f"arguments cannot be broadcast together: {shapes}") from exc
 
 
+def _parameter_and_factors(value: Any, name: str, n: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A non-negative parameter and the averaging factors (int and float), broadcastable."""
+    parameter = _as_nonnegative(value, name)
+    m = _as_whole(n, "n")
+    _broadcast(parameter, m, names=(name, "n"))
+    return parameter, m, m.astype(np.float64)
+
+
 # --------------------------------------------------------------------------- processes
 def av_wn(sigma2: Any, n: Any) -> float | np.ndarray:
     r"""Theoretical Allan variance of a stationary white noise.
@@ -136,9 +144,7 @@ def av_wn(sigma2: Any, n: Any) -> float | np.ndarray:
     >>> av_wn(1.0, [1, 2, 4])
     array([1.  , 0.5 , 0.25])
     """
-    s2 = _as_nonnegative(sigma2, "sigma2")
-    m = _as_whole(n, "n")
-    _broadcast(s2, m, names=("sigma2", "n"))
+    s2, m, _ = _parameter_and_factors(sigma2, "sigma2", n)
     return _finish(s2 / m, s2, m)
 
 
@@ -170,10 +176,7 @@ def av_qn(Q2: Any, n: Any) -> float | np.ndarray:
     >>> av_qn(1, [1, 2])
     array([3.  , 0.75])
     """
-    q2 = _as_nonnegative(Q2, "Q2")
-    m = _as_whole(n, "n")
-    _broadcast(q2, m, names=("Q2", "n"))
-    mf = m.astype(np.float64)
+    q2, m, mf = _parameter_and_factors(Q2, "Q2", n)
     return _finish(3.0 * q2 / (mf * mf), q2, m)
 
 
@@ -205,10 +208,7 @@ def av_rw(omega2: Any, n: Any) -> float | np.ndarray:
     >>> av_rw(1, [1, 2])
     array([0.5 , 0.75])
     """
-    w2 = _as_nonnegative(omega2, "omega2")
-    m = _as_whole(n, "n")
-    _broadcast(w2, m, names=("omega2", "n"))
-    mf = m.astype(np.float64)
+    w2, m, mf = _parameter_and_factors(omega2, "omega2", n)
     return _finish((2.0 * mf * mf + 1.0) * w2 / (6.0 * mf), w2, m)
 
 
