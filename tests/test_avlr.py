@@ -24,8 +24,8 @@ from avar.estimate import averaging_factors, avar, n_differences, relative_error
 from avar.models import DR, QN, RW, WN
 from avar.results import AllanVariance, ImuAllanVariance
 
-# The package re-exports the function avlr under the submodule's name.
-avlr_module = importlib.import_module("avar.avlr")
+# The package re-exports the function avlr under the name of its submodule.
+bootstrap_module = importlib.import_module("avar.bootstrap")
 
 
 def exact_av(model, n=2**16, freq=1.0, type="mo"):
@@ -234,7 +234,7 @@ def test_bootstrap_removes_a_known_bias():
     fit = avlr(exact_av(RW(gamma2=gamma**2)), rw=[1, 2], ci=True, B=20, seed=3)
     assert fit.estimates["RW"] / gamma - 1 == pytest.approx(0.0378, abs=0.001)
     assert fit.ci.loc["RW", "Estimate"] == pytest.approx(gamma, rel=0.002)
-    draws = avlr_module.bootstrap_estimates(fit.model, fit.av, fit.scales_used, 20, seed=3)["RW"]
+    draws = bootstrap_module.bootstrap_estimates(fit.model, fit.av, fit.scales_used, 20, seed=3)["RW"]
     assert fit.ci.loc["RW", "Estimate"] == pytest.approx(2 * fit.estimates["RW"] - draws.mean(), rel=1e-12)
     assert fit.ci.loc["RW", "SD"] == pytest.approx(draws.std(ddof=1), rel=1e-12)
 
@@ -259,7 +259,7 @@ def test_bootstrap_coverage_of_white_noise():
 
 
 def test_progress_bar_only_on_a_terminal(monkeypatch, capsys):
-    monkeypatch.setattr(avlr_module, "PROGRESS_MIN_SAMPLES", 1)
+    monkeypatch.setattr(bootstrap_module, "PROGRESS_MIN_SAMPLES", 1)
     x = WN(1).simulate(2000, seed=1)
     avlr(x, wn=[1, 2], ci=True, B=5, seed=1)
     assert capsys.readouterr().err == ""
@@ -269,14 +269,14 @@ def test_progress_bar_only_on_a_terminal(monkeypatch, capsys):
             return True
 
     terminal = Terminal()
-    monkeypatch.setattr(avlr_module.sys, "stderr", terminal)
+    monkeypatch.setattr(bootstrap_module.sys, "stderr", terminal)
     avlr(x, wn=[1, 2], ci=True, B=5, seed=1)
     assert "avlr bootstrap" in terminal.getvalue() and "5/5" in terminal.getvalue()
 
 
 def test_bootstrap_in_several_chunks_matches_one_chunk_statistically(monkeypatch):
     x = WN(1).simulate(4096, seed=2)
-    monkeypatch.setattr(avlr_module, "CHUNK_SAMPLES", 3 * 4096)  # chunks of 3 replicates
+    monkeypatch.setattr(bootstrap_module, "CHUNK_SAMPLES", 3 * 4096)  # chunks of 3 replicates
     fit = avlr(x, wn=range(1, 11), ci=True, B=200, seed=3)
     assert np.isfinite(fit.ci.to_numpy()).all()
     assert fit.ci.loc["WN", "SD"] == pytest.approx(avlr(x, wn=range(1, 11), ci=True, B=200, seed=4).ci.loc["WN", "SD"], rel=0.25)

@@ -24,18 +24,15 @@ public pieces :func:`check_scale_selections`, :func:`fit_slopes`,
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy.stats import norm
 
 from avar._validation import check_whole_numbers
-from avar.estimate import allan_variance_columns
 from avar.estimate import avar as allan_variance
 from avar.models import DR, QN, RW, WN, NoiseModel, Process, check_count, check_real
 from avar.results import AllanVariance, ImuAllanVariance, format_frequency, frozen_array
@@ -53,11 +50,6 @@ SLOPES = {"WN": -0.5, "QN": -1.0, "RW": 0.5, "DR": 1.0}
 COEFFICIENTS = {"WN": 1.0, "QN": np.sqrt(3.0), "RW": 1.0 / np.sqrt(3.0), "DR": 1.0 / np.sqrt(2.0)}
 #: Parameter symbol and unit (u: data unit, s: unit of tau).
 PARAMETER_LABELS = {"WN": "sigma [u s^1/2]", "QN": "Q [u s]", "RW": "gamma [u s^-1/2]", "DR": "omega [u s^-1]"}
-#: Bootstrap samples per chunk of replicates: ~28 bytes each (series, scratch and the
-#: compensated cumulative sums) bound the memory to about 1 GB whatever B and N.
-CHUNK_SAMPLES = 1 << 25
-#: A progress bar is drawn (on a terminal) when B * N reaches this.
-PROGRESS_MIN_SAMPLES = 50_000_000
 
 
 # --------------------------------------------------------------------------- building blocks
@@ -235,70 +227,6 @@ def per_sample_model(estimates: Mapping[str, float], freq: float) -> NoiseModel:
     if not estimates:
         raise ValueError("estimates is empty; give at least one process -> parameter")
     return sum((per_sample_process(p, v, freq) for p, v in estimates.items()), start=0)
-
-
-# --------------------------------------------------------------------------- bootstrap
-def show_progress(done: int, total: int) -> None:
-    """Draw the bootstrap progress bar on stderr (a newline when done)."""
-    filled = 30 * done // total
-    end = "\n" if done == total else ""
-    sys.stderr.write(f"\ravlr bootstrap [{'#' * filled}{'.' * (30 - filled)}] {done}/{total}{end}")
-    sys.stderr.flush()
-
-
-def bootstrap_estimates(
-    model: NoiseModel, av: AllanVariance, selections: Mapping[str, np.ndarray], replicates: int,
-    seed: Any = None, progress: Callable[[int, int], None] | None = None,
-) -> dict[str, np.ndarray]:
-    """AVLR estimates of ``replicates`` series simulated from ``model``.
-
-    Each replicate has the length ``av.n``; its Allan variance of type
-    ``av.type`` is computed only at the selected averaging factors of ``av``
-    and refitted with tau = ``av.levels`` (so at ``av.freq``). Replicates are
-    generated in chunks of at most :data:`CHUNK_SAMPLES` samples, a chunk at
-    a time, and their Allan variances computed in one parallel call;
-    ``progress(done, replicates)`` is called after every chunk.
-
-    Returns process -> float64 array of the ``replicates`` estimates.
-    """
-    rng = np.random.default_rng(seed)
-    used = np.unique(np.concatenate(list(selections.values()))) - 1
-    factors = av.averaging_factors[used]
-    log_tau = np.log(av.levels[used])
-    positions = {p: np.searchsorted(used, s - 1) for p, s in selections.items()}
-    chunk = max(1, min(replicates, CHUNK_SAMPLES // av.n))
-    estimates = {p: np.empty(replicates) for p in selections}
-    buffer = np.empty((chunk, av.n))
-    for start in range(0, replicates, chunk):
-        rows = buffer[: min(chunk, replicates - start)]
-        model.simulate_into(rows, rng)
-        with np.errstate(divide="ignore"):
-            log_adev = 0.5 * np.log(allan_variance_columns(rows.T, factors, av.type))
-        for process, where in positions.items():
-            estimates[process][start : start + rows.shape[0]] = _log_mean_estimate(
-                process, log_adev[:, where], log_tau[where]
-            )
-        if progress is not None:
-            progress(start + rows.shape[0], replicates)
-    return estimates
-
-
-def bootstrap_table(estimates: pd.Series, replicates: Mapping[str, np.ndarray], alpha: float) -> pd.DataFrame:
-    """Bias-corrected estimates, bootstrap SDs and normal intervals.
-
-    Estimate = 2 theta - mean(theta*), SD = sd(theta*) (ddof 1),
-    Lower/Upper = Estimate -/+ z SD with z the normal *quantile*
-    ``norm.ppf(1 - alpha / 2)`` (R ``avar`` 0.1.3 used the density
-    ``dnorm(1 - alpha/2)`` = 0.248 for alpha = 0.05, 8 times too narrow).
-    """
-    z = norm.ppf(1.0 - alpha / 2.0)
-    means = np.array([replicates[p].mean() for p in estimates.index])
-    sds = np.array([replicates[p].std(ddof=1) for p in estimates.index])
-    corrected = 2.0 * estimates.to_numpy() - means
-    return pd.DataFrame(
-        {"Estimate": corrected, "SD": sds, "Lower": corrected - z * sds, "Upper": corrected + z * sds},
-        index=estimates.index,
-    )
 
 
 # --------------------------------------------------------------------------- result
@@ -526,9 +454,9 @@ def avlr(
     model = per_sample_model(estimates.to_dict(), av.freq)
     table = None
     if ci:
-        long_run = replicates * av.n >= PROGRESS_MIN_SAMPLES and getattr(sys.stderr, "isatty", bool)()
-        draws = bootstrap_estimates(model, av, selections, replicates, seed, show_progress if long_run else None)
-        table = bootstrap_table(estimates, draws, alpha)
+        from avar.bootstrap import parametric_bootstrap
+
+        table = parametric_bootstrap(estimates, model, av, selections, replicates, alpha, seed)
     return AvlrResult(
         estimates=estimates,
         scales_used=selections,
