@@ -67,13 +67,16 @@ def memory_of_large_run(n: int) -> tuple[float, float]:
     """Peak RSS (GB) and avar time (s) of a subprocess computing the 'mo' AV of n samples."""
     code = textwrap.dedent(
         f"""
-        import resource, time, numpy as np, avar
+        import time, numpy as np, avar
         avar.avar(np.random.default_rng(0).standard_normal(1000))  # compile outside the timing
         x = np.random.default_rng(1).standard_normal({n})
         start = time.perf_counter()
         avar.avar(x)
         elapsed = time.perf_counter() - start
-        print(elapsed, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+        # VmHWM: this address space's peak (ru_maxrss would include the parent's
+        # resident size at fork time, which survives exec).
+        peak_kb = next(int(line.split()[1]) for line in open("/proc/self/status") if line.startswith("VmHWM"))
+        print(elapsed, peak_kb)
         """
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout

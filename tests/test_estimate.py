@@ -216,3 +216,15 @@ def test_result_is_immutable_and_printable():
     assert len(text.splitlines()) == len(result) + 2
     assert "<table" in result._repr_html_()
     assert "AllanVariance" in repr(result)
+
+
+def test_reused_workspace_is_safe_across_threads_and_lengths():
+    from concurrent.futures import ThreadPoolExecutor
+
+    rng = np.random.default_rng(9)
+    series = [rng.standard_normal(n).cumsum() for n in (5000, 20_000, 777, 20_000, 3000, 60_000)] * 3
+    expected = [avar.avar(x).allan for x in series]  # one at a time
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        results = list(pool.map(lambda x: avar.avar(x).allan, series))
+    for got, want in zip(results, expected):
+        np.testing.assert_array_equal(got, want)

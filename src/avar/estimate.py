@@ -5,6 +5,7 @@ Validation and tau grids live here; the loops are in :mod:`avar._kernels`.
 
 from __future__ import annotations
 
+import threading
 from typing import Any
 
 import numpy as np
@@ -108,6 +109,33 @@ def averaging_factors(n: int, freq: float = 1.0, taus: Any = "octave") -> np.nda
 CUMSUM_BUDGET = 1 << 28
 
 
+class _Workspace:
+    """The cumulative-sum buffers, kept between calls while they fit the budget.
+
+    Faulting in fresh pages costs about as much as the cumulative sum itself,
+    so repeated calls (bootstrap replicates, channel batches, notebooks) reuse
+    one pair of buffers of at most ``CUMSUM_BUDGET`` bytes. A call that finds
+    them in use by another thread, or needs more, allocates its own.
+    """
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.hi = np.empty(0, dtype=np.float64)
+        self.lo = np.empty(0, dtype=np.float32)
+
+    def arrays(self, rows: int, columns: int, reuse: bool) -> tuple[np.ndarray, np.ndarray]:
+        size = rows * columns
+        if reuse and 12 * size <= CUMSUM_BUDGET:
+            if self.hi.size < size:
+                self.hi = np.empty(size, dtype=np.float64)
+                self.lo = np.empty(size, dtype=np.float32)
+            return self.hi[:size].reshape(rows, columns), self.lo[:size].reshape(rows, columns)
+        return np.empty((rows, columns), dtype=np.float64), np.empty((rows, columns), dtype=np.float32)
+
+
+_WORKSPACE = _Workspace()
+
+
 def allan_variance_columns(data: np.ndarray, factors: np.ndarray, type: str) -> np.ndarray:
     """Allan variance of every column of ``data`` at cluster sizes ``factors``.
 
@@ -120,21 +148,25 @@ def allan_variance_columns(data: np.ndarray, factors: np.ndarray, type: str) -> 
     """
     n, channels = data.shape
     factors = np.asarray(factors, dtype=np.int64)
-    centre = data.mean(axis=0)
-    span = np.maximum(data.max(axis=0) - centre, centre - data.min(axis=0))
+    centre, low, high = _kernels.column_moments(data)
+    span = np.maximum(high - centre, centre - low)
     _, exponent = np.frexp(np.where(span > 0, span, 1.0))
     scale = np.ldexp(1.0, -exponent)
     strides = factors if type == "to" else np.ones_like(factors)
     counts = n_differences(n, factors, type)
     batch = max(1, min(channels, CUMSUM_BUDGET // (12 * (n + 1))))
-    hi = np.empty((batch, n + 1), dtype=np.float64)
-    lo = np.empty((batch, n + 1), dtype=np.float32)
     sums = np.empty((channels, factors.shape[0]))
-    for first in range(0, channels, batch):
-        last = min(channels, first + batch)
-        k = last - first
-        _kernels.centred_cumsum(data[:, first:last], centre[first:last], scale[first:last], hi[:k], lo[:k])
-        sums[first:last] = _kernels.squared_difference_sums(hi[:k], lo[:k], factors, strides, counts)
+    owned = _WORKSPACE.lock.acquire(blocking=False)
+    try:
+        hi, lo = _WORKSPACE.arrays(batch, n + 1, reuse=owned)
+        for first in range(0, channels, batch):
+            last = min(channels, first + batch)
+            k = last - first
+            _kernels.centred_cumsum(data[:, first:last], centre[first:last], scale[first:last], hi[:k], lo[:k])
+            sums[first:last] = _kernels.squared_difference_sums(hi[:k], lo[:k], factors, strides, counts)
+    finally:
+        if owned:
+            _WORKSPACE.lock.release()
     unscale = np.ldexp(1.0, 2 * exponent)[:, None]
     return sums * unscale / (2.0 * factors.astype(np.float64) ** 2 * counts)
 
