@@ -287,7 +287,7 @@ def test_result_display_and_immutability():
     x = (WN(1) + RW(1e-6)).simulate(2**14, seed=1)
     fit = avlr(x, wn=range(1, 6), rw=[11, 12, 13])
     assert isinstance(fit, AvlrResult)
-    assert list(fit.summary().columns) == ["Value"]
+    assert list(fit.summary().columns) == ["Parameter", "Value"]
     text = str(fit)
     assert "WN on scales 1-5" in text and "RW on scales 11-13" in text
     assert f"{fit.estimates['WN']:.6g}" in text and "sigma" in text and "Per-sample model" in text
@@ -300,7 +300,7 @@ def test_result_display_and_immutability():
     with pytest.raises(TypeError):
         fit.scales_used["WN"] = np.array([1])
     with_ci = avlr(x, wn=range(1, 6), ci=True, B=10, seed=1)
-    assert list(with_ci.summary().columns) == ["Value", "Bias-corrected", "SD", "Lower", "Upper"]
+    assert list(with_ci.summary().columns) == ["Parameter", "Value", "Bias-corrected", "SD", "Lower", "Upper"]
     assert "95% normal intervals" in str(with_ci) and "B = 10" in str(with_ci)
 
 
@@ -339,3 +339,22 @@ def test_allan_variance_with_fewer_than_two_levels_is_rejected():
     imu = ImuAllanVariance(sensor="test", freq=1.0, n=10, channels={}, sensor_types=(), axes=())
     with pytest.raises(ValueError, match="IMU data take qn_gyro"):  # single-series scales on IMU data
         avlr(imu, wn=[1])
+
+
+def test_fit_results_cannot_be_edited():
+    x = WN(sigma2=1.0).simulate(4096, seed=5)
+    fit = avlr(x, wn=range(1, 6), ci=True, B=10, seed=1)
+    with pytest.raises(ValueError, match="read-only"):
+        fit.estimates["WN"] = 99.0
+    with pytest.raises(ValueError, match="read-only"):
+        fit.ci.iloc[0, 0] = -1.0
+    with pytest.raises(ValueError, match="read-only"):
+        fit.implied_ad[0] = 0.0
+
+
+def test_scale_selections_must_be_flat_and_sane():
+    x = WN(sigma2=1.0).simulate(4096, seed=6)
+    with pytest.raises(ValueError, match="flat list"):
+        avlr(x, wn=[[1, 2], [3, 4]])
+    with pytest.raises(ValueError, match="too large"):
+        avlr(x, wn=[1e30])

@@ -228,3 +228,30 @@ def test_reused_workspace_is_safe_across_threads_and_lengths():
         results = list(pool.map(lambda x: avar.avar(x).allan, series))
     for got, want in zip(results, expected):
         np.testing.assert_array_equal(got, want)
+
+
+def test_integers_beyond_2_to_53_are_exact():
+    base = [0, 1, 3, 0, 7, 2]
+    expected = avar.avar(np.array(base), taus="all").allan
+    # float64(2**62 + 1) == float64(2**62): without the exact integer shift the AV would be 0.
+    np.testing.assert_allclose(avar.avar(np.array(base, dtype=np.int64) + 2**62, taus="all").allan, expected, rtol=1e-14)
+    np.testing.assert_allclose(
+        avar.avar(np.array(base, dtype=np.uint64) + np.uint64(2**63), taus="all").allan, expected, rtol=1e-14
+    )
+
+
+def test_extreme_magnitudes():
+    np.testing.assert_allclose(avar.avar([1e150, -1e150, 1e150, -1e150, 1e150], taus=[1]).allan, [2e300], rtol=1e-15)
+    assert avar.avar([1e-320, 0.0, 1e-320, 0.0, 5e-324, 0.0], taus=[1]).allan[0] == 0.0  # underflows, as exact
+    with pytest.raises(ValueError, match="overflows float64"):
+        avar.avar([1e300, -1e300, 1e300, -1e300, 1e300], taus=[1])
+
+
+def test_decreasing_time_index_is_named():
+    index = pd.date_range("2024-01-01", periods=10, freq="1s")[::-1]
+    with pytest.raises(ValueError, match="does not increase strictly"):
+        avar.avar(pd.Series(np.arange(10.0), index=index))
+
+
+def test_numpy_integer_length():
+    assert averaging_factors(np.int64(100)).tolist() == [2, 4, 8, 16, 32]

@@ -91,7 +91,8 @@ def test_summary_and_print(navchip_fit):
     table = navchip_fit.summary()
     assert table.index.names == ["Sensor type", "Process"]
     assert list(table.index) == [(GYRO, "WN"), (GYRO, "QN"), (GYRO, "RW"), (ACCEL, "WN"), (ACCEL, "RW")]
-    assert list(table.columns) == ["Value", "Scales"]
+    assert list(table.columns) == ["Parameter", "Value", "Scales"]
+    assert table.loc[(GYRO, "RW"), "Parameter"] == "gamma [u s^-1/2]"
     assert table.loc[(GYRO, "QN"), "Scales"] == "1-4"
     assert table.loc[(ACCEL, "RW"), "Value"] == navchip_fit.estimates[ACCEL]["RW"]
     text = str(navchip_fit)
@@ -103,7 +104,7 @@ def test_summary_and_print(navchip_fit):
 def test_per_axis_summary(navchip):
     fit = imu_avlr(navchip, wn_gyro=range(1, 4), wn_acc=2, per_axis=True)
     table = fit.summary()
-    assert list(table.columns) == ["X", "Y", "Z", "Scales"]
+    assert list(table.columns) == ["Parameter", "X", "Y", "Z", "Scales"]
     assert list(table.index) == [(GYRO, "WN"), (ACCEL, "WN")]
     assert "Axis" in str(fit)
 
@@ -191,5 +192,25 @@ def test_public_avlr_dispatches_imu_data(navchip, navchip_fit):
         avar.avlr(navchip, wn=range(1, 5))
     with pytest.raises(ValueError, match="single series only"):
         avar.avlr(navchip, ci=True, **NAVCHIP_SCALES)
-    with pytest.raises(TypeError, match=r"\['wn_gyro'\] apply to IMU data only"):
+    with pytest.raises(ValueError, match=r"\['wn_gyro'\] apply to IMU data only"):
         avar.avlr(navchip["Gyro. X"], wn_gyro=range(1, 5))
+
+
+def test_imu_fit_results_cannot_be_edited(navchip_fit, navchip):
+    with pytest.raises(ValueError, match="read-only"):
+        navchip_fit.estimates[GYRO]["WN"] = 1.0
+    per_axis = imu_avlr(navchip, wn_gyro=range(1, 4), wn_acc=2, per_axis=True)
+    with pytest.raises(ValueError, match="read-only"):
+        per_axis.estimates[GYRO].iloc[0, 0] = 1.0
+
+
+def test_imu_fit_needs_two_levels():
+    imu = IMU(np.random.default_rng(0).standard_normal((7, 2)), freq=1.0, gyro=[0], accel=[1])
+    with pytest.raises(ValueError, match="fewer than 2 levels"):
+        avar.avlr(avar.avar(imu), wn_gyro=1, wn_acc=1)
+
+
+def test_integers_beyond_2_to_53_are_refused_by_imu():
+    data = np.zeros((10, 2), dtype=np.int64) + 2**60
+    with pytest.raises(ValueError, match="beyond 2\\*\\*53"):
+        IMU(data, freq=1.0, gyro=[0], accel=[1])

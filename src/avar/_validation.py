@@ -15,6 +15,33 @@ import pandas as pd
 
 MIN_SAMPLES = 4
 
+#: Integers beyond this magnitude are not all exact in float64.
+EXACT_INTEGER_LIMIT = 2**53
+
+
+def integer_range(array: np.ndarray) -> tuple[int, int] | None:
+    """(min, max) of an integer array as Python ints, or None for other dtypes."""
+    if array.dtype.kind not in "iu" or array.size == 0:
+        return None
+    return int(array.min()), int(array.max())
+
+
+def as_float64(array: np.ndarray) -> np.ndarray:
+    """Contiguous float64 values of a real 1-D array.
+
+    Integers beyond 2**53 are first shifted by an exact integer offset (the
+    midrange): the Allan variance does not depend on a shift, and the shifted
+    values convert exactly as long as the data span less than 2**53.
+    """
+    bounds = integer_range(array)
+    if bounds is None or max(abs(bounds[0]), abs(bounds[1])) <= EXACT_INTEGER_LIMIT:
+        return np.ascontiguousarray(array, dtype=np.float64)
+    offset = (bounds[0] + bounds[1]) // 2
+    if array.dtype.kind == "i":
+        return (array - np.int64(offset)).astype(np.float64)
+    above = array >= np.uint64(offset)
+    return np.where(above, (array - np.uint64(offset)).astype(np.float64), -(np.uint64(offset) - array).astype(np.float64))
+
 
 def check_freq(freq: Any, name: str = "freq") -> float:
     """A finite, positive sampling frequency as float."""
@@ -64,7 +91,9 @@ def rate_from_index(index: pd.Index, what: str) -> float | None:
         return None
     steps = np.diff(index.to_numpy()).astype("timedelta64[ns]").astype(np.int64)
     step_ns = steps[0]
-    if step_ns <= 0 or np.any(steps != step_ns):
+    if np.any(steps <= 0):
+        raise ValueError(f"{what} has a time index that does not increase strictly; sort it or drop duplicate times")
+    if np.any(steps != step_ns):
         raise ValueError(
             f"{what} has an irregular time index (steps from {steps.min()} to {steps.max()} ns); "
             "resample it to a regular grid or pass freq explicitly with positional data"
@@ -94,7 +123,7 @@ def as_series(x: Any, freq: Any) -> tuple[np.ndarray, float]:
             f"x must be 1-D, got an array of shape {array.shape}; give a 1-D series or an avar.IMU"
         )
     check_length(array.shape[0], what)
-    values = np.ascontiguousarray(array, dtype=np.float64)
+    values = as_float64(array)
     check_finite(values, what)
     if freq is None:
         rate = index_rate if index_rate is not None else 1.0
@@ -111,4 +140,6 @@ def check_whole_numbers(values: Any, name: str) -> np.ndarray:
     if array.dtype.kind == "f":
         if not np.all(np.isfinite(array)) or np.any(array != np.round(array)):
             raise ValueError(f"{name} must hold whole numbers, got {values!r}")
+        if np.any(np.abs(array) >= 2.0**62):
+            raise ValueError(f"{name} holds numbers too large to be scales or sizes: {values!r}")
     return array.astype(np.int64)

@@ -35,7 +35,7 @@ import pandas as pd
 from avar._validation import check_whole_numbers
 from avar.estimate import avar as allan_variance
 from avar.models import DR, QN, RW, WN, NoiseModel, Process, check_count, check_real
-from avar.results import AllanVariance, ImuAllanVariance, format_frequency, frozen_array
+from avar.results import AllanVariance, ImuAllanVariance, format_frequency, frozen_array, frozen_frame, frozen_series
 
 __all__ = ["PROCESSES", "AvlrResult", "avlr", "check_scale_selections", "fit_slopes",
            "implied_allan_deviation", "per_sample_process", "per_sample_model"]
@@ -50,6 +50,16 @@ SLOPES = {"WN": -0.5, "QN": -1.0, "RW": 0.5, "DR": 1.0}
 COEFFICIENTS = {"WN": 1.0, "QN": np.sqrt(3.0), "RW": 1.0 / np.sqrt(3.0), "DR": 1.0 / np.sqrt(2.0)}
 #: Parameter symbol and unit (u: data unit, s: unit of tau).
 PARAMETER_LABELS = {"WN": "sigma [u s^1/2]", "QN": "Q [u s]", "RW": "gamma [u s^-1/2]", "DR": "omega [u s^-1]"}
+
+
+def parameter_label(process: str, unit: str | None = None) -> str:
+    """Symbol and unit of a process parameter, ``u`` replaced by the data unit when known.
+
+    >>> parameter_label("WN"), parameter_label("RW", "deg/s")
+    ('sigma [u s^1/2]', 'gamma [deg/s s^-1/2]')
+    """
+    label = PARAMETER_LABELS[process]
+    return label.replace("[u ", f"[{unit} ") if unit else label
 
 
 # --------------------------------------------------------------------------- building blocks
@@ -90,7 +100,9 @@ def check_scale_selections(selections: Mapping[str, Any], n_levels: int, suffix:
         argument = process.lower() + suffix
         if isinstance(value, (str, bytes)):
             raise TypeError(f"{argument} must be scale numbers (an int, a range or a list), got a string")
-        scales = check_whole_numbers(list(value) if isinstance(value, range) else value, argument).ravel()
+        if np.ndim(value) > 1:
+            raise ValueError(f"{argument} must be a flat list of scale numbers, got shape {np.shape(value)}")
+        scales = check_whole_numbers(list(value) if isinstance(value, range) else value, argument)
         if scales.size == 0:
             raise ValueError(f"{argument} selects no scale; give scale numbers between 1 and {n_levels}")
         outside = scales[(scales < 1) | (scales > n_levels)]
@@ -277,21 +289,22 @@ class AvlrResult:
 
     def __post_init__(self) -> None:
         set_field = object.__setattr__
-        set_field(self, "estimates", self.estimates.copy())
+        set_field(self, "estimates", frozen_series(self.estimates))
         set_field(self, "implied_ad", frozen_array(self.implied_ad))
         for name in ("scales_used", "implied_ad_decomp"):
             dtype = np.int64 if name == "scales_used" else np.float64
             set_field(self, name, MappingProxyType({k: frozen_array(v, dtype) for k, v in getattr(self, name).items()}))
         if self.ci is not None:
-            set_field(self, "ci", self.ci.copy())
+            set_field(self, "ci", frozen_frame(self.ci))
 
     def summary(self) -> pd.DataFrame:
         """The estimate table, one row per process.
 
-        Columns ``Value`` (the fit) and, when bootstrap intervals were
-        computed, ``Bias-corrected``, ``SD``, ``Lower``, ``Upper``.
+        Columns ``Parameter`` (symbol and unit), ``Value`` (the fit) and,
+        when bootstrap intervals were computed, ``Bias-corrected``, ``SD``,
+        ``Lower``, ``Upper``.
         """
-        table = pd.DataFrame({"Value": self.estimates})
+        table = pd.DataFrame({"Parameter": [parameter_label(p) for p in self.estimates.index], "Value": self.estimates})
         if self.ci is not None:
             table = table.join(self.ci.rename(columns={"Estimate": "Bias-corrected"}))
         table.index.name = "Process"
@@ -307,7 +320,6 @@ class AvlrResult:
 
     def __str__(self) -> str:
         table = self.summary()
-        table.insert(0, "Parameter", [PARAMETER_LABELS[p] for p in table.index])
         lines = [self.describe(), "of the " + self.av.describe()]
         if self.ci is not None:
             lines.append(
@@ -437,7 +449,7 @@ def avlr(
         return imu_avlr(x, per_axis=per_axis, **imu_selections)
     given = sorted(name for name, value in imu_selections.items() if value is not None)
     if given or per_axis:
-        raise TypeError(f"{given or ['per_axis']} apply to IMU data only; for one series use qn, wn, rw, dr")
+        raise ValueError(f"{given or ['per_axis']} apply to IMU data only; for one series use qn, wn, rw, dr")
     av = x if isinstance(x, AllanVariance) else allan_variance(x)
     if len(av) < 2:
         raise ValueError(f"x has an Allan variance of {len(av)} level(s); AVLR needs at least 2 levels")

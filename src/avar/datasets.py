@@ -51,8 +51,6 @@ import pandas as pd
 from avar.estimate import check_type, n_differences
 from avar.results import AllanVariance, ImuAllanVariance
 
-#: Upstream repository of the R package.
-UPSTREAM_REPOSITORY = "https://github.com/SMAC-Group/avar"
 #: Git ref the files are downloaded from. No commit hash could be verified
 #: offline, so the branch is used and :data:`SHA256` guarantees integrity.
 UPSTREAM_REF_MASTER = "master"

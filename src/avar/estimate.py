@@ -74,6 +74,7 @@ def averaging_factors(n: int, freq: float = 1.0, taus: Any = "octave") -> np.nda
     >>> averaging_factors(100, freq=10.0, taus=[0.1, 0.5, 0.5, 2.0]).tolist()
     [1, 5, 20]
     """
+    n = int(n)
     largest = max_averaging_factor(n)
     if isinstance(taus, str):
         grid = taus.lower()
@@ -149,8 +150,10 @@ def allan_variance_columns(data: np.ndarray, factors: np.ndarray, type: str) -> 
     n, channels = data.shape
     factors = np.asarray(factors, dtype=np.int64)
     centre, low, high = _kernels.column_moments(data)
-    span = np.maximum(high - centre, centre - low)
-    _, exponent = np.frexp(np.where(span > 0, span, 1.0))
+    with np.errstate(over="ignore"):
+        span = np.maximum(high - centre, centre - low)  # inf only for |x| near the float64 limit
+    _, exponent = np.frexp(np.where((span > 0) & np.isfinite(span), span, 1.0))
+    exponent = np.clip(exponent, -1000, 1000)  # 2**-exponent stays a normal float64
     scale = np.ldexp(1.0, -exponent)
     strides = factors if type == "to" else np.ones_like(factors)
     counts = n_differences(n, factors, type)
@@ -167,8 +170,15 @@ def allan_variance_columns(data: np.ndarray, factors: np.ndarray, type: str) -> 
     finally:
         if owned:
             _WORKSPACE.lock.release()
-    unscale = np.ldexp(1.0, 2 * exponent)[:, None]
-    return sums * unscale / (2.0 * factors.astype(np.float64) ** 2 * counts)
+    unscale = np.ldexp(1.0, exponent)[:, None]
+    with np.errstate(over="ignore"):
+        allan = sums / (2.0 * factors.astype(np.float64) ** 2 * counts) * unscale * unscale
+    if not np.all(np.isfinite(allan)):
+        raise ValueError(
+            "the Allan variance overflows float64 (the data reach "
+            f"{np.max(np.maximum(np.abs(low), np.abs(high))):.3g}); rescale the data, e.g. to other units"
+        )
+    return allan
 
 
 def relative_errors(n: int, factors: np.ndarray) -> np.ndarray:

@@ -17,7 +17,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar._validation import check_finite, check_freq, check_length, check_numeric_dtype, rate_from_index
+from avar._validation import (
+    EXACT_INTEGER_LIMIT,
+    check_finite,
+    check_freq,
+    check_length,
+    check_numeric_dtype,
+    integer_range,
+    rate_from_index,
+)
 from avar.estimate import allan_variance_columns, averaging_factors, n_differences, relative_errors
 from avar.results import AllanVariance, ImuAllanVariance
 
@@ -40,6 +48,12 @@ TYPE_ALIASES = {
 
 def _frozen_matrix(values: np.ndarray) -> np.ndarray:
     """A read-only float64 copy in column-major order (each channel contiguous)."""
+    bounds = integer_range(np.asarray(values))
+    if bounds is not None and max(abs(bounds[0]), abs(bounds[1])) > EXACT_INTEGER_LIMIT:
+        raise ValueError(
+            f"data holds integers up to {max(abs(bounds[0]), abs(bounds[1]))}, beyond 2**53, which float64 "
+            "cannot hold exactly; subtract an integer offset (e.g. the first sample) first"
+        )
     matrix = np.array(values, dtype=np.float64, order="F", copy=True)
     matrix.flags.writeable = False
     return matrix

@@ -29,10 +29,11 @@ from avar.avlr import (
     fit_slopes,
     format_scales,
     implied_allan_deviation,
+    parameter_label,
     per_sample_model,
 )
 from avar.models import NoiseModel
-from avar.results import AllanVariance, ImuAllanVariance, frozen_array
+from avar.results import AllanVariance, ImuAllanVariance, frozen_array, frozen_frame, frozen_series
 
 __all__ = ["ImuAvlrResult", "imu_avlr"]
 
@@ -81,11 +82,11 @@ class ImuAvlrResult:
     --------
     >>> from avar import datasets
     >>> fit = imu_avlr(datasets.load("navchip_av"), wn_gyro=range(1, 8), wn_acc=range(1, 8))
-    >>> print(fit.summary())
-                             Value Scales
-    Sensor type   Process
-    Gyroscope     WN       0.00007    1-7
-    Accelerometer WN       0.00053    1-7
+    >>> table = fit.summary()
+    >>> list(table.columns)
+    ['Parameter', 'Value', 'Scales']
+    >>> table["Value"].round(7).tolist()  # sigma of the gyroscopes, of the accelerometers
+    [6.96e-05, 0.0005295]
     """
 
     imu_av: ImuAllanVariance
@@ -98,7 +99,8 @@ class ImuAvlrResult:
 
     def __post_init__(self) -> None:
         set_field = object.__setattr__
-        set_field(self, "estimates", _frozen_mapping({k: v.copy() for k, v in self.estimates.items()}))
+        frozen = {k: frozen_frame(v) if isinstance(v, pd.DataFrame) else frozen_series(v) for k, v in self.estimates.items()}
+        set_field(self, "estimates", _frozen_mapping(frozen))
         set_field(
             self,
             "scales_used",
@@ -122,13 +124,16 @@ class ImuAvlrResult:
     def summary(self) -> pd.DataFrame:
         """All estimates in one table indexed by (sensor type, process).
 
-        Columns: ``Value`` (joint fit) or one column per axis (per-axis fit),
-        then ``Scales``, the 1-based scales the process was fitted on.
+        Columns: ``Parameter`` (symbol and unit, with the sensor type's unit
+        when the IMU has one), ``Value`` (joint fit) or one column per axis
+        (per-axis fit), then ``Scales``, the 1-based scales of the process.
         """
         frames = {}
         for kind, estimates in self.estimates.items():
             table = pd.DataFrame({"Value": estimates}) if not self.per_axis else estimates.T.copy()
             table.columns = [str(c) for c in table.columns]
+            unit = self.imu_av.units.get(kind)
+            table.insert(0, "Parameter", [parameter_label(p, unit) for p in table.index])
             table["Scales"] = [format_scales(self.scales_used[kind][p]) for p in table.index]
             frames[kind] = table
         return pd.concat(frames, names=["Sensor type", "Process"])
@@ -144,8 +149,7 @@ class ImuAvlrResult:
                 table = estimates.copy()
                 table.index.name = "Axis"
             else:
-                table = pd.DataFrame({"Value": estimates})
-                table["Scales"] = [format_scales(self.scales_used[kind][p]) for p in table.index]
+                table = self.summary().loc[kind]
             heading = HEADINGS.get(kind, f"Estimates for {kind}:")
             lines += ["", f" {heading}", table.to_string(float_format=lambda v: f"{v:.6g}")]
         return "\n".join(lines)
@@ -170,18 +174,21 @@ class ImuAvlrResult:
 
 
 def _check_input(imu_av: Any) -> ImuAllanVariance:
-    if isinstance(imu_av, ImuAllanVariance):
-        return imu_av
     from avar.imu import IMU
 
     if isinstance(imu_av, IMU):
         from avar.estimate import avar
 
-        return avar(imu_av)
-    raise TypeError(
-        f"imu_av must be an ImuAllanVariance (avar.avar(imu) or avar.datasets.load(...)) or an IMU, "
-        f"got {type(imu_av).__name__}"
-    )
+        imu_av = avar(imu_av)
+    if not isinstance(imu_av, ImuAllanVariance):
+        raise TypeError(
+            f"imu_av must be an ImuAllanVariance (avar.avar(imu) or avar.datasets.load(...)) or an IMU, "
+            f"got {type(imu_av).__name__}"
+        )
+    short = {name: len(av) for name, av in imu_av.channels.items() if len(av) < 2}
+    if short:
+        raise ValueError(f"channels {short} have fewer than 2 levels; AVLR needs at least 2 levels")
+    return imu_av
 
 
 def _implied(estimates: Mapping[str, float], av: AllanVariance) -> dict[str, np.ndarray]:

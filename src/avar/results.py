@@ -26,6 +26,18 @@ def frozen_array(values: Any, dtype: type = np.float64) -> np.ndarray:
     return array
 
 
+def frozen_series(series: pd.Series) -> pd.Series:
+    """A copy of a float Series whose values cannot be assigned to."""
+    return pd.Series(frozen_array(series.to_numpy()), index=series.index.copy(), name=series.name, copy=False)
+
+
+def frozen_frame(frame: pd.DataFrame) -> pd.DataFrame:
+    """A copy of a float DataFrame whose values cannot be assigned to."""
+    values = np.array(frame.to_numpy(dtype=np.float64), copy=True)
+    values.flags.writeable = False
+    return pd.DataFrame(values, index=frame.index.copy(), columns=frame.columns.copy(), copy=False)
+
+
 def format_frequency(freq: float) -> str:
     """``250`` -> ``"250 Hz"``, ``0.5`` -> ``"0.5 Hz"``."""
     return f"{freq:g} Hz"
@@ -108,7 +120,11 @@ class AllanVariance:
     def summary(self) -> pd.DataFrame:
         """The table of R's ``summary.avar``: one row per level.
 
-        Columns ``Time`` (tau, s), ``AVar``, ``ADev``, ``Lower CI``, ``Upper CI``.
+        Columns ``Time`` (tau, s), ``AVar``, ``ADev``, ``Lower CI``, ``Upper CI``;
+        the index ``Scale`` numbers the levels from 1, as the scale selections
+        of :func:`avar.avlr` do. The CI columns bound the Allan *deviation*
+        (R's adev (1 -/+ 2 errors)); the lower one is negative where
+        errors > 1/2, i.e. at scales m > N/3.
         """
         return pd.DataFrame(
             {
@@ -119,6 +135,7 @@ class AllanVariance:
                 "Upper CI": self.uci,
             },
             columns=SUMMARY_COLUMNS,
+            index=pd.RangeIndex(1, len(self) + 1, name="Scale"),
         )
 
     def describe(self) -> str:
@@ -213,9 +230,9 @@ class ImuAllanVariance:
         return len(self.channels)
 
     def summary(self) -> pd.DataFrame:
-        """All channels' summary tables stacked, indexed by (channel, level)."""
+        """All channels' summary tables stacked, indexed by (channel, 1-based scale)."""
         frames = {name: av.summary() for name, av in self.channels.items()}
-        return pd.concat(frames, names=["Channel", "Level"])
+        return pd.concat(frames, names=["Channel", "Scale"])
 
     def describe(self) -> str:
         return (
