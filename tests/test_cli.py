@@ -50,7 +50,7 @@ def test_compute_gives_the_library_numbers(series_file, tmp_path):
     assert result.returncode == 0, result.stderr
     table = pd.read_csv(out)
     for name, values in (("gx", gx), ("gy", gy)):
-        expected = avar.avar(values, type="to", freq=50.0).summary()
+        expected = avar.avar(values, type="to", freq=50.0).summary().reset_index()  # Scale column
         got = table[table["Channel"] == name].drop(columns="Channel").reset_index(drop=True)
         pd.testing.assert_frame_equal(got, expected, rtol=1e-14, atol=0)
     assert (tmp_path / "av.png").read_bytes().startswith(PNG_MAGIC)
@@ -151,3 +151,32 @@ def test_console_script_is_installed():
     assert shutil.which("avar"), "the console script 'avar' is not on PATH: install the package (pip install .)"
     result = run("fit", "--help", script=True)
     assert result.returncode == 0 and "--wn SCALES" in result.stdout
+
+
+def test_freq_overrides_the_rate_but_time_stays_out_of_the_data(series_file):
+    result = run("compute", str(series_file[0]), "--freq", "25")
+    assert result.returncode == 0, result.stderr
+    assert "time" not in set(pd.read_csv(io.StringIO(result.stdout), sep=r"\s+")["Channel"])
+    assert "at 25 Hz (--freq)" in result.stderr
+    from_time = run("compute", str(series_file[0]), "--column", "gx")
+    assert "at 50 Hz (time column 'time')" in from_time.stderr
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--column", "gx", "--wn", "7:1"], "invalid scale range '7:1'"),
+        (["--gyro", "gx", "--gyro", "gy", "--wn", "1:5", "--ci"], "--ci (bootstrap intervals) is available for one series"),
+        (["--column", "gx", "--wn", "1:5", "--wn-gyro", "1:3"], "--wn-gyro apply to IMU fits only"),
+    ],
+)
+def test_fit_options_that_do_not_go_together_exit_2(series_file, args, message):
+    result = run("fit", str(series_file[0]), *args)
+    assert result.returncode == 2
+    assert message in result.stderr
+
+
+def test_closed_pipe_is_not_an_error(series_file):
+    command = f"'{sys.executable}' -m avar compute '{series_file[0]}' | head -1"
+    result = subprocess.run(command, shell=True, capture_output=True, text=True, timeout=300)
+    assert "Scale" in result.stdout and "error" not in result.stderr

@@ -45,8 +45,9 @@ def test_time_column_gives_the_rate(tmp_path):
     frame = pd.DataFrame({"timestamp": stamps.astype(str), "v": np.arange(50.0)})
     frame.to_csv(tmp_path / "d.csv", index=False)
     assert read_series(tmp_path / "d.csv").freq == pytest.approx(4.0)
-    with pytest.raises(InputFileError, match="column .timestamp. is not numeric"):
-        read_series(tmp_path / "d.csv", use_time=False)  # without the time role it is data
+    without_rate = read_series(tmp_path / "d.csv", rate_from_time=False)  # e.g. --freq given
+    assert list(without_rate.columns) == ["v"] and without_rate.freq is None  # time is never data
+    assert without_rate.time_column == "timestamp"
 
 
 def test_time_column_must_be_regular_and_increasing(tmp_path):
@@ -78,3 +79,28 @@ def test_npy_files(tmp_path):
 def test_bad_tables(tmp_path, text, message):
     with pytest.raises(InputFileError, match=message):
         read_series(write(tmp_path, "bad.csv", text))
+
+
+def test_time_column_names_and_units(tmp_path):
+    rows = "\n".join(f"{1_700_000_000_000_000_000 + 5_000_000 * k},{k % 3}" for k in range(100))
+    ns = write(tmp_path, "ns.csv", "timestamp (ns),gx\n" + rows + "\n")
+    assert read_series(ns, time_unit="ns").freq == pytest.approx(200.0, rel=1e-9)
+    table = read_series(write(tmp_path, "u.csv", "Time [s],Gyro X [deg/s]\n0,1\n0.5,2\n1.0,3\n1.5,4\n"))
+    assert list(table.columns) == ["Gyro X [deg/s]"] and table.freq == pytest.approx(2.0)
+    # Epoch seconds printed with 6 decimals: rounding jitters the steps by ~1e-4 of a step.
+    epoch = "\n".join(f"{1_700_000_000 + k / 100:.6f},{k}" for k in range(500))
+    assert read_series(write(tmp_path, "e.csv", "time,v\n" + epoch + "\n")).freq == pytest.approx(100.0, rel=1e-6)
+
+
+def test_comments_trailing_blank_lines_and_decimal_commas(tmp_path):
+    table = read_series(write(tmp_path, "c.csv", "# logged by a sensor\na,b\n1,2\n3,4\n5,6\n7,8\n\n\n"))
+    assert list(table.columns) == ["a", "b"] and len(table.columns) == 4
+    euro = read_series(write(tmp_path, "eu.csv", "a;b\n0,5;1\n1,5;2\n2,5;3\n3,5;4\n"))
+    np.testing.assert_array_equal(euro.columns["a"], [0.5, 1.5, 2.5, 3.5])
+    with pytest.raises(InputFileError, match=r"row 2 \(line 3\)"):  # a blank line inside the data is missing
+        read_series(write(tmp_path, "gap.csv", "a\n1\n\n3\n4\n5\n"))
+
+
+def test_dates_must_be_iso_8601(tmp_path):
+    with pytest.raises(InputFileError, match="neither numbers nor ISO 8601"):
+        read_series(write(tmp_path, "dmy.csv", "date,v\n31/01/2024 10:00,1\n31/01/2024 10:01,2\n31/01/2024 10:02,3\n31/01/2024 10:03,4\n"))

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from avar.estimate import avar
-from avar.files import InputFileError, read_series
+from avar.files import TIME_UNITS, InputFileError, read_series
 
 DEMO_FREQ = 100.0
 DEMO_N = 100_000
@@ -49,6 +49,8 @@ def parse_scales(text: str) -> list[int]:
         try:
             if ":" in part:
                 low, high = (int(v) for v in part.split(":"))
+                if low > high:
+                    raise argparse.ArgumentTypeError(f"invalid scale range {part!r}: {low} > {high}")
                 scales.extend(range(low, high + 1))
             else:
                 scales.append(int(part))
@@ -92,9 +94,19 @@ def compute_from_args(args: argparse.Namespace, progress: Progress):
     from avar.imu import IMU
 
     progress(f"reading {args.file}")
-    table = read_series(args.file, args.column or None, use_time=args.freq is None)
-    freq = args.freq if args.freq is not None else (table.freq or 1.0)
-    progress(f"{len(table.columns)} column(s) x {len(table.columns.index)} samples at {freq:g} Hz; computing")
+    columns = args.column or ((args.gyro or []) + (args.accel or [])) or None
+    table = read_series(args.file, columns, rate_from_time=args.freq is None, time_unit=args.time_unit)
+    if args.freq is not None:
+        freq, source = args.freq, "--freq"
+    elif table.freq is not None:
+        freq, source = table.freq, f"time column {table.time_column!r}"
+    else:
+        freq, source = 1.0, "no time column: pass --freq for seconds"
+    print(
+        f"{args.file}: {len(table.columns.columns)} column(s) x {len(table.columns)} samples at {freq:g} Hz ({source})",
+        file=sys.stderr,
+    )
+    progress("computing")
     if args.gyro or args.accel:
         imu = IMU(table.columns, freq=freq, gyro=args.gyro, accel=args.accel, name=Path(args.file).stem)
         return avar(imu, type=args.type, taus=args.taus)
@@ -106,13 +118,13 @@ def compute_from_args(args: argparse.Namespace, progress: Progress):
 
 
 def summary_of(results) -> pd.DataFrame:
-    """One summary table; several channels get a leading Channel column."""
+    """One flat summary table: a Scale column (1-based), and Channel when there are several."""
     if isinstance(results, dict):
         if len(results) == 1:
-            return next(iter(results.values())).summary()
+            return next(iter(results.values())).summary().reset_index()
         frames = {name: res.summary() for name, res in results.items()}
-        return pd.concat(frames, names=["Channel", "Level"]).reset_index(level=0).reset_index(drop=True)
-    return results.summary().reset_index(level=0).reset_index(drop=True)
+        return pd.concat(frames, names=["Channel", "Scale"]).reset_index()
+    return results.summary().reset_index()
 
 
 def figure_of(results):
@@ -159,6 +171,13 @@ def imu_selections(args: argparse.Namespace, present_types) -> dict[str, list[in
 def run_fit(args: argparse.Namespace) -> int:
     from avar.avlr import avlr
 
+    imu = bool(args.gyro or args.accel)
+    per_sensor = [f"--{name}-{suffix}" for name, _ in PROCESSES for suffix in ("gyro", "acc")
+                  if getattr(args, f"{name}_{suffix}")]
+    if imu and args.ci:
+        raise UsageError("--ci (bootstrap intervals) is available for one series, not for IMU fits")
+    if per_sensor and not imu:
+        raise UsageError(f"{', '.join(per_sensor)} apply to IMU fits only (name the columns with --gyro/--accel)")
     progress = Progress()
     results = compute_from_args(args, progress)
     progress("fitting")
@@ -203,6 +222,10 @@ def run_datasets(args: argparse.Namespace) -> int:
     return 0
 
 
+class UsageError(Exception):
+    """Options that do not go together (exit code 2, like argparse's own errors)."""
+
+
 class Parser(argparse.ArgumentParser):
     """argparse with one-line usage errors (exit code 2)."""
 
@@ -214,6 +237,9 @@ def add_input_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", help="CSV, whitespace-separated text or .npy file")
     parser.add_argument("--column", action="append", metavar="NAME", help="column to use (repeatable; default: all)")
     parser.add_argument("--freq", type=float, help="sampling rate in Hz (default: from a time column, else 1)")
+    parser.add_argument(
+        "--time-unit", choices=sorted(TIME_UNITS), default="s", help="unit of a numeric time column (default s)"
+    )
     parser.add_argument("--type", choices=["mo", "to"], default="mo", help="maximal overlap (mo) or tau overlap (to)")
     parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help="tau grid")
     parser.add_argument("--gyro", action="append", metavar="NAME", help="gyroscope column (makes an IMU)")
@@ -258,12 +284,15 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return args.handler(args)
+    except BrokenPipeError:  # output piped into e.g. head, which closed it (an OSError: first)
+        sys.stderr.close()
+        return 0
+    except UsageError as error:
+        print(f"avar {args.command}: error: {error}", file=sys.stderr)
+        return 2
     except (InputFileError, ValueError, TypeError, OSError) as error:
         print(f"avar: error: {error}", file=sys.stderr)
         return 1
-    except BrokenPipeError:  # output piped into e.g. head, which closed it
-        sys.stderr.close()
-        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

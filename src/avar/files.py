@@ -16,8 +16,26 @@ import pandas as pd
 
 from avar._validation import MIN_SAMPLES
 
-#: Column names taken as the time axis (case-insensitive).
-TIME_COLUMNS = ("time", "t", "timestamp", "times", "seconds", "time_s", "time (s)", "datetime", "date")
+#: Column names taken as the time axis (case-insensitive, units in brackets
+#: ignored); names starting with "time" count too.
+TIME_COLUMNS = ("t", "timestamp", "stamp", "seconds", "sec", "datetime", "date")
+
+#: Seconds per unit of a numeric time column.
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+
+#: Largest relative deviation of a time step from the mean step: sensor logs
+#: print their times with limited decimals, which alone jitters the steps.
+TIME_STEP_TOLERANCE = 1e-3
+
+
+def is_time_column(name: str) -> bool:
+    """``time``, ``Time [s]``, ``timestamp (ns)``, ``t`` ... but not ``gyro_t``.
+
+    >>> [is_time_column(n) for n in ("Time [s]", "timestamp", "t", "gx", "gyro_time")]
+    [True, True, True, False, False]
+    """
+    bare = re.sub(r"[\[(].*?[\])]", "", name).strip().lower()
+    return bare.startswith("time") or bare in TIME_COLUMNS
 
 
 class InputFileError(ValueError):
@@ -31,6 +49,7 @@ class SeriesTable:
     columns: pd.DataFrame
     freq: float | None
     path: Path
+    time_column: str | None = None
 
 
 def _is_number(token: str) -> bool:
@@ -49,15 +68,17 @@ def _read_text(path: Path) -> tuple[pd.DataFrame, bool]:
     try:
         with path.open("r", encoding="utf-8", errors="replace") as handle:
             first = handle.readline()
-            while first and not first.strip():
+            while first and (not first.strip() or first.lstrip().startswith("#")):
                 first = handle.readline()
+            second = handle.readline()
     except OSError as error:
         raise InputFileError(f"{path}: cannot read the file ({error.strerror or error})") from error
     if not first.strip():
         raise InputFileError(f"{path}: the file is empty")
-    separator = next((sep for sep in (",", ";", "\t") if sep in first), r"\s+")
+    separator = next((sep for sep in (";", "\t", ",") if sep in first), r"\s+")
+    decimal_comma = separator == ";" and re.search(r"\d,\d", second + first) is not None
     tokens = [token.strip().strip('"') for token in re.split(separator, first.strip())]
-    has_header = not all(_is_number(token) for token in tokens if token)
+    has_header = not all(_is_number(token.replace(",", ".") if decimal_comma else token) for token in tokens if token)
     if has_header and len(set(tokens)) != len(tokens):
         raise InputFileError(f"{path}: duplicate column names {tokens}")
     try:
@@ -67,11 +88,17 @@ def _read_text(path: Path) -> tuple[pd.DataFrame, bool]:
             header=0 if has_header else None,
             engine="python" if separator == r"\s+" else "c",
             skip_blank_lines=False,  # a blank line is a missing value, not nothing
+            comment="#",
             dtype=str,
             keep_default_na=False,
         )
     except (pd.errors.ParserError, UnicodeDecodeError, ValueError) as error:
         raise InputFileError(f"{path}: not a readable CSV/text table ({str(error).splitlines()[0]})") from error
+    blank = frame.isna() | (frame == "")
+    filled = np.flatnonzero(~blank.all(axis=1).to_numpy())
+    frame = frame.iloc[: filled[-1] + 1 if filled.size else 0]  # trailing blank lines end the file
+    if decimal_comma:
+        frame = frame.apply(lambda column: column.str.replace(",", ".", regex=False))
     if not has_header:
         frame.columns = [f"x{i + 1}" for i in range(frame.shape[1])] if frame.shape[1] > 1 else ["x"]
     frame.columns = [str(name).strip() for name in frame.columns]
@@ -116,31 +143,45 @@ def _numeric(frame: pd.DataFrame, name: str, path: Path, first_line: int) -> np.
     return values
 
 
-def _rate_from_time(frame: pd.DataFrame, name: str, path: Path, first_line: int) -> float:
-    """Sampling rate (Hz) of a regular time column, seconds or date-times."""
+def _rate_from_time(frame: pd.DataFrame, name: str, path: Path, first_line: int, unit: str) -> float:
+    """Sampling rate (Hz) of a regular time column: numbers in ``unit`` or ISO 8601 date-times."""
     raw = frame[name]
     text = raw.astype(str).str.strip()
-    if all(_is_number(token) for token in text.iloc[:5]):
-        seconds = _numeric(frame, name, path, first_line)
+    ticks = None
+    if text.str.fullmatch(r"-?\d{1,19}").all():
+        try:  # integer stamps (e.g. epoch nanoseconds) are exact in int64, not in float64
+            ticks = np.array([int(token) for token in text], dtype=np.int64)
+        except OverflowError:
+            ticks = None
+    if ticks is not None:
+        seconds = (ticks - ticks[0]).astype(np.float64) * TIME_UNITS[unit]
+    elif all(_is_number(token) for token in text.iloc[:5]):
+        numbers = _numeric(frame, name, path, first_line)
+        seconds = (numbers - numbers[0]) * TIME_UNITS[unit]
     else:
         try:
-            stamps = pd.to_datetime(text, errors="raise")
+            stamps = pd.to_datetime(text, format="ISO8601")
         except (ValueError, TypeError) as error:
-            raise InputFileError(f"{path}: time column {name!r} holds neither seconds nor date-times") from error
+            raise InputFileError(
+                f"{path}: time column {name!r} holds neither numbers nor ISO 8601 date-times "
+                f"(e.g. 2024-01-31T12:00:00.010); first value {text.iloc[0]!r}"
+            ) from error
         seconds = (stamps - stamps.iloc[0]).dt.total_seconds().to_numpy()
     steps = np.diff(seconds)
     if steps.size == 0 or np.any(steps <= 0):
         raise InputFileError(f"{path}: time column {name!r} must increase strictly")
     step = float(seconds[-1] - seconds[0]) / steps.size  # more accurate than any single step
-    if np.max(np.abs(steps - step)) > 1e-6 * step:
+    if np.max(np.abs(steps - step)) > TIME_STEP_TOLERANCE * step:
         raise InputFileError(
             f"{path}: time column {name!r} is irregular (steps from {steps.min():g} to {steps.max():g} s); "
-            "resample it or pass --freq"
+            "resample it, or pass --freq to treat the samples as regular"
         )
     return 1.0 / step
 
 
-def read_series(path: str | Path, columns: list[str] | None = None, use_time: bool = True) -> SeriesTable:
+def read_series(
+    path: str | Path, columns: list[str] | None = None, rate_from_time: bool = True, time_unit: str = "s"
+) -> SeriesTable:
     """Read numeric columns (and the rate of a time column) from a file.
 
     Parameters
@@ -151,13 +192,18 @@ def read_series(path: str | Path, columns: list[str] | None = None, use_time: bo
         Columns without a header are named ``x`` (one column) or ``x1, x2, ...``.
     columns : list of str, optional
         Columns to keep (default: every column but the time column).
-    use_time : bool
-        Whether a column named like ``time``/``timestamp`` gives the rate.
+    rate_from_time : bool
+        Whether the time column (named like ``time``, ``Time [s]``,
+        ``timestamp``; see :func:`is_time_column`) gives the rate. It is never
+        data either way.
+    time_unit : {"s", "ms", "us", "ns"}
+        Unit of a numeric time column.
 
     Returns
     -------
     SeriesTable
-        ``columns`` as float64 DataFrame, ``freq`` from the time column or None.
+        ``columns`` as float64 DataFrame, ``freq`` from the time column or
+        None, and ``time_column`` (its name, or None).
 
     Examples
     --------
@@ -176,7 +222,7 @@ def read_series(path: str | Path, columns: list[str] | None = None, use_time: bo
     else:
         frame, has_header = _read_text(path)
         first_line = 2 if has_header else 1  # file line of the first data row
-    time_name = next((name for name in frame.columns if name.lower() in TIME_COLUMNS), None) if use_time else None
+    time_name = next((name for name in frame.columns if is_time_column(name)), None)
     if columns:
         unknown = [name for name in columns if name not in frame.columns]
         if unknown:
@@ -189,5 +235,7 @@ def read_series(path: str | Path, columns: list[str] | None = None, use_time: bo
     if len(frame) < MIN_SAMPLES:
         raise InputFileError(f"{path}: {len(frame)} sample(s); the Allan variance needs at least {MIN_SAMPLES}")
     data = pd.DataFrame({name: _numeric(frame, name, path, first_line) for name in wanted})
-    freq = _rate_from_time(frame, time_name, path, first_line) if time_name is not None else None
-    return SeriesTable(columns=data, freq=freq, path=path)
+    freq = None
+    if time_name is not None and rate_from_time:
+        freq = _rate_from_time(frame, time_name, path, first_line, time_unit)
+    return SeriesTable(columns=data, freq=freq, path=path, time_column=time_name)
