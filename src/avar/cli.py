@@ -80,7 +80,7 @@ def run_demo(args: argparse.Namespace) -> int:
     fit = avlr(result, **DEMO_SCALES)
     print(f"Simulated {DEMO_N} samples of white noise + random walk at {DEMO_FREQ:g} Hz")
     print(result.describe())
-    print(format_table(result.summary()))
+    print(format_table(result.summary().reset_index()))  # with the Scale numbers the fit uses
     print()
     print(fit)
     figure_path = out / "avar_demo.png"
