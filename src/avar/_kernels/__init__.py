@@ -1,0 +1,35 @@
+"""Hot loops of the library, compiled with numba: nothing else lives here.
+
+Nothing here validates input or builds objects: the public functions
+validate once at the boundary and call these kernels on clean arrays. The
+tests check every kernel against a plain NumPy transcription.
+
+* :mod:`avar._kernels.allan`: the empirical Allan variance (compensated
+  cumulative sums, squared second differences per level).
+* :mod:`avar._kernels.covariance`: the theoretical Allan variance of a
+  covariance matrix (one validating pass, then O(n) per scale).
+"""
+
+import os
+
+# numba's OpenMP threads spin-wait between parallel regions by default; when
+# another process holds a core, a short parallel call can then take 10-100x
+# longer. A short spin before sleeping keeps full speed on an idle machine and
+# degrades gracefully on a busy one. The user's own settings win. (Read by
+# libgomp when numba first starts its thread pool, i.e. after this import.)
+if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
+    os.environ["GOMP_SPINCOUNT"] = "1000"
+
+from avar._kernels.allan import (  # noqa: E402
+    BLOCK,
+    CHUNK,
+    CUMSUM_BLOCK,
+    FUSED_BLOCK,
+    FUSED_MAX_LEVELS,
+    centred_cumsum,
+    column_moments,
+    fused_overlapping_sums,
+    squared_difference_sums,
+    task_sums,
+)
+from avar._kernels.covariance import COV_TILE, NOAV_SCAN_RATIO, covariance_pass, moav_from_sums  # noqa: E402
