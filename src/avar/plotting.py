@@ -28,12 +28,12 @@ and the IMU grids :func:`plot_imu_avar` and :func:`plot_imu_avlr` of
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.colors import is_color_like, to_rgba
+from matplotlib.colors import is_color_like
 from matplotlib.figure import Figure, FigureBase
 
 from avar.results import AllanVariance
@@ -207,6 +207,41 @@ def draw_empirical(
     return drawn
 
 
+def draw_fit(
+    ax: Axes,
+    av: AllanVariance,
+    implied_ad: Any,
+    decomposition: Mapping[str, Any] | None,
+    scales: Mapping[str, Any] | None,
+    *,
+    deviation: bool,
+    colour: Any,
+    marker: str,
+    markersize: float,
+    widths: tuple[float, float],
+) -> np.ndarray:
+    """Overlay a fit on ``ax``: its implied curve, and when given the implied
+    curve of each process (dashed) and the scales each process was fitted on.
+
+    ``widths`` are the line widths of the implied total and of the processes.
+    Returns the implied curve as drawn (AD or AV).
+    """
+    power = 1 if deviation else 2
+    curve = np.asarray(implied_ad, dtype=np.float64) ** power
+    ax.plot(av.levels, curve, color=colour, marker="o" if marker else "", markersize=markersize * 1.2,
+            markerfacecolor="none", linewidth=widths[0], label=f"Implied {quantity(deviation)}", zorder=4)
+    for process, ad in (decomposition or {}).items():
+        ax.plot(av.levels, np.asarray(ad) ** power, color=PROCESS_COLOURS.get(process, "0.3"),
+                linewidth=widths[1], linestyle="--", label=process, zorder=2)
+    values = values_of(av, deviation)
+    for process, used in (scales or {}).items():
+        index = np.asarray(used, dtype=np.int64) - 1
+        ax.plot(av.levels[index], values[index], linestyle="none", marker=marker or "o",
+                markersize=markersize * 1.15, color=PROCESS_COLOURS.get(process, "0.3"),
+                label=f"Scales used for {process}", zorder=5)
+    return curve
+
+
 def finish(ax: Axes, xlab: str, ylab: str, main: str | None, legend: str | None,
            limits: tuple[float, float] | None) -> None:
     """Labels, title, y limits and legend."""
@@ -373,22 +408,10 @@ def plot_avlr(
                     ci=ci, deviation=deviation, legend_position=None, marker=marker,
                     markersize=markersize, ax=ax)
     ax = fig.axes[0] if ax is None else ax
-    av, power = x.av, 1 if deviation else 2
-    name = quantity(deviation)
-    implied = np.asarray(x.implied_ad) ** power
-    ax.plot(av.levels, implied, color=col_implied, marker="o" if marker else "", markersize=markersize * 1.2,
-            markerfacecolor="none", linewidth=2, label=f"Implied {name}", zorder=4)
-    if decomp:
-        for process, ad in x.implied_ad_decomp.items():
-            ax.plot(av.levels, np.asarray(ad) ** power, color=PROCESS_COLOURS.get(process, "0.3"),
-                    linewidth=1.3, linestyle="--", label=process, zorder=2)
-    if show_scales:
-        values = values_of(av, deviation)
-        for process, scales in x.scales_used.items():
-            index = np.asarray(scales, dtype=np.int64) - 1
-            ax.plot(av.levels[index], values[index], linestyle="none", marker=marker or "o",
-                    markersize=markersize * 1.15, color=PROCESS_COLOURS.get(process, "0.3"),
-                    label=f"Scales used for {process}", zorder=5)
+    av = x.av
+    implied = draw_fit(ax, av, x.implied_ad, x.implied_ad_decomp if decomp else None,
+                       x.scales_used if show_scales else None, deviation=deviation, colour=col_implied,
+                       marker=marker, markersize=markersize, widths=(2.0, 1.3))
     lower, upper, valid = band(av, deviation)
     drawn = [values_of(av, deviation), implied] + ([lower[valid], upper[valid]] if ci else [])
     finish(ax, ax.get_xlabel(), ax.get_ylabel(), None, check_legend_position(legend_position),
@@ -396,122 +419,14 @@ def plot_avlr(
     return fig
 
 
-def compare_items(results: Any, labels: Any) -> list[tuple[str, AllanVariance]]:
-    """(label, AllanVariance) pairs of :func:`plot_compare`'s arguments."""
-    from avar.avlr import AvlrResult
-
-    if isinstance(results, Mapping):
-        if labels is not None:
-            raise ValueError("give the labels either as the keys of a mapping or as labels=, not both")
-        labels, results = [str(k) for k in results], list(results.values())
-    elif isinstance(results, str) or not isinstance(results, Sequence):
-        hint = " (for an IMU pass its .channels)" if hasattr(results, "channels") else ""
-        raise TypeError(
-            "results must be a list (or a mapping label -> result) of AllanVariance or AvlrResult, "
-            f"got {type(results).__name__}{hint}"
-        )
-    results = list(results)
-    if not results:
-        raise ValueError("plot_compare needs at least one result, got an empty collection")
-    items = []
-    for i, res in enumerate(results):
-        if isinstance(res, AvlrResult):
-            res = res.av
-        check_result(res, f"results[{i}]")
-        items.append(res)
-    if labels is None:
-        labels = [res.name or f"Series {i + 1}" for i, res in enumerate(items)]
-    else:
-        if isinstance(labels, str) or not isinstance(labels, Sequence):
-            raise TypeError(f"labels must be a list of strings, got {labels!r}")
-        if len(labels) != len(items):
-            raise ValueError(f"got {len(labels)} labels for {len(items)} results; give one label per result")
-        labels = [str(label) for label in labels]
-    return list(zip(labels, items))
-
-
-def plot_compare(
-    results: Sequence[Any] | Mapping[str, Any],
-    labels: Sequence[str] | None = None,
-    units: str | None = None,
-    xlab: str | None = None,
-    ylab: str | None = None,
-    main: str | None = None,
-    colours: Sequence[Any] | None = None,
-    ci: bool = False,
-    deviation: bool = False,
-    legend_position: str | None = "lower left",
-    marker: str = "o",
-    markersize: float = 4.0,
-    ax: Axes | None = None,
-) -> Figure:
-    """Overlay the Allan variances of several sensors or runs on one plot.
-
-    Parameters
-    ----------
-    results : list of AllanVariance or AvlrResult, or mapping label -> result
-        The curves, drawn in order. An :class:`AvlrResult` contributes its
-        empirical Allan variance ``.av``. A mapping such as
-        ``imu_res.channels`` gives the labels as its keys.
-    labels : list of str, optional
-        One legend label per result; default: each result's ``name``, else
-        ``"Series 1"``, ``"Series 2"``, ...
-    units, xlab, ylab : str, optional
-        As in :func:`plot_avar`.
-    main : str, optional
-        Title; default ``"Allan Variance Comparison"`` (``""`` for none).
-    colours : list of matplotlib colours, optional
-        One per result; default the matplotlib cycle ``"C0"``, ``"C1"``, ...
-    ci : bool
-        Also shade each curve's confidence band in its colour (off by default,
-        overlapping bands hide each other).
-    deviation, legend_position, marker, markersize, ax
-        As in :func:`plot_avar`.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import avar
-    >>> rng = np.random.default_rng(1)
-    >>> a = avar.avar(rng.standard_normal(4096), freq=10.0)
-    >>> b = avar.avar(2 * rng.standard_normal(8192), freq=10.0)
-    >>> fig = plot_compare([a, b], labels=["unit A", "unit B"], deviation=True)
-    >>> [line.get_label() for line in fig.axes[0].lines]
-    ['unit A', 'unit B']
-    >>> plot_compare([])
-    Traceback (most recent call last):
-    ...
-    ValueError: plot_compare needs at least one result, got an empty collection
-    """
-    items = compare_items(results, labels)
-    deviation, ci, legend, markersize = check_style(
-        deviation, ci, legend_position, markersize, {}, {"units": units, "xlab": xlab, "ylab": ylab, "main": main})
-    if colours is None:
-        colours = [f"C{i % 10}" for i in range(len(items))]
-    else:
-        if isinstance(colours, str) or not isinstance(colours, Sequence) or len(colours) != len(items):
-            raise ValueError(f"colours must be a list of {len(items)} colours, one per result, got {colours!r}")
-        for i, colour in enumerate(colours):
-            check_colour(colour, f"colours[{i}]")
-    fig, ax = new_axes(ax)
-    setup_log_axes(ax)
-    drawn = []
-    for (label, av), colour in zip(items, colours):
-        drawn += draw_empirical(ax, av, deviation=deviation, colour=colour, band_colour=to_rgba(colour, 0.15),
-                                ci=ci, marker=marker, markersize=markersize, label=label, band_label=None)
-    xlab, ylab = axis_labels(units, deviation, xlab, ylab)
-    finish(ax, xlab, ylab, "Allan Variance Comparison" if main is None else main, legend, log_limits(*drawn))
-    return fig
-
-
 def __getattr__(name: str) -> Any:
-    """The IMU grids live in :mod:`avar.plotting_imu`; they are re-exported lazily."""
+    """The IMU grids and the comparison live in their own modules; re-exported lazily."""
     if name in ("plot_imu_avar", "plot_imu_avlr"):
         from avar import plotting_imu
 
         return getattr(plotting_imu, name)
+    if name == "plot_compare":
+        from avar import plotting_compare
+
+        return plotting_compare.plot_compare
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -18,10 +18,10 @@ from avar.plotting import (
     AD_COLOUR,
     CI_COLOUR,
     IMPLIED_COLOUR,
-    PROCESS_COLOURS,
     check_flag,
     check_style,
     draw_empirical,
+    draw_fit,
     log_limits,
     quantity,
     root_figure,
@@ -94,7 +94,6 @@ def draw_grid(
         raise ValueError("fig already has axes; pass an empty Figure (or SubFigure) for the grid")
     grid = fig.subplots(len(rows), len(columns), sharex=True, sharey="row", squeeze=False)
     name = quantity(deviation)
-    power = 1 if deviation else 2
     legend_axes = None
     for r, kind in enumerate(rows):
         drawn = []
@@ -110,19 +109,9 @@ def draw_grid(
                                     marker=marker, markersize=markersize, label=f"Empirical {name}",
                                     band_label=f"CI({name}, 0.95)")
             if implied is not None and channel in implied:
-                curve = np.asarray(implied[channel], dtype=np.float64) ** power
-                ax.plot(av.levels, curve, color=col_implied, marker="o" if marker else "",
-                        markersize=markersize * 1.2, markerfacecolor="none", linewidth=1.8,
-                        label=f"Implied {name}", zorder=4)
-                drawn.append(curve)
-            for process, ad in (decomposition or {}).get(channel, {}).items():
-                ax.plot(av.levels, np.asarray(ad) ** power, color=PROCESS_COLOURS.get(process, "0.3"),
-                        linewidth=1.1, linestyle="--", label=process, zorder=2)
-            for process, used in (scales or {}).get(kind, {}).items():
-                index = np.asarray(used, dtype=np.int64) - 1
-                ax.plot(av.levels[index], (av.adev if deviation else av.allan)[index], linestyle="none",
-                        marker=marker or "o", markersize=markersize * 1.15,
-                        color=PROCESS_COLOURS.get(process, "0.3"), label=f"Scales used for {process}", zorder=5)
+                drawn.append(draw_fit(ax, av, implied[channel], (decomposition or {}).get(channel),
+                                      (scales or {}).get(kind), deviation=deviation, colour=col_implied,
+                                      marker=marker, markersize=markersize, widths=(1.8, 1.1)))
             if all((rr, c) not in cells for rr in range(r)):
                 ax.set_title(f"Axis - {axis}")
             if all((r, cc) not in cells for cc in range(c)):
