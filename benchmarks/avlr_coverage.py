@@ -21,7 +21,7 @@ import time
 import numpy as np
 from scipy.stats import norm
 
-from avar.avlr import avlr
+from avar.fit.avlr import avlr
 
 N = 10_000
 REPLICATES = 100

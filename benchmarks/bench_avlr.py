@@ -16,7 +16,7 @@ import statistics
 import sys
 import time
 
-from avar.avlr import avlr
+from avar.fit.avlr import avlr
 from avar.models import RW, WN
 
 REPEATS = 3

@@ -21,10 +21,10 @@ from pathlib import Path
 import numpy as np
 
 try:
-    from avar.nonstationary import _check_covmat, moav, noav
+    from avar.models.nonstationary import _check_covmat, moav, noav
 except ImportError:  # run from a source checkout without PYTHONPATH
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
-    from avar.nonstationary import _check_covmat, moav, noav
+    from avar.models.nonstationary import _check_covmat, moav, noav
 
 
 def direct_av(n: int, covmat: np.ndarray, starts) -> float:

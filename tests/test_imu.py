@@ -9,9 +9,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import avar
-from avar import imu as imu_module
-from avar.imu import IMU, imu_avar
-from avar.results import AllanVariance, ImuAllanVariance
+import avar.stability.allan as estimation_module
+from avar.imu import IMU
+from avar.stability.results import AllanVariance, ImuAllanVariance
 
 GYRO, ACCEL = "Gyroscope", "Accelerometer"
 R_NAMES = ("Gyro. X", "Gyro. Y", "Gyro. Z", "Accel. X", "Accel. Y", "Accel. Z")
@@ -250,20 +250,20 @@ def test_avar_of_dataframe_imu_uses_column_names():
 
 def test_all_channels_in_one_kernel_call(monkeypatch):
     calls = []
-    original = imu_module.allan_variance_columns
+    original = estimation_module.allan_variance_columns
 
     def counting(data, factors, kind):
         calls.append(data.shape)
         return original(data, factors, kind)
 
-    monkeypatch.setattr(imu_module, "allan_variance_columns", counting)
+    monkeypatch.setattr(estimation_module, "allan_variance_columns", counting)
     avar.avar(six_axis(2_000))
     assert calls == [(2_000, 6)]
 
 
-def test_imu_avar_direct_call_and_freq_rejected():
+def test_imu_avar_grid_and_freq_rejected():
     imu = six_axis(1_000)
-    assert imu_avar(imu, "mo", "octave")["Gyro. Z"].allan.shape == (8,)
+    assert avar.avar(imu, type="mo", taus="octave")["Gyro. Z"].allan.shape == (8,)
     with pytest.raises(ValueError, match="carries its own freq"):
         avar.avar(imu, freq=10.0)
     with pytest.raises(ValueError, match="unknown Allan variance type"):

@@ -1,55 +1,73 @@
 """avar: the Allan variance of time series and latent noise model estimation.
 
-The public API is re-exported here; see each module for the details.
+The public API is re-exported here lazily (PEP 562): ``import avar`` loads
+only this file, and each name imports its module (and NumPy, numba, pandas or
+matplotlib) on first use. See ``docs/architecture.md`` for the layers.
 """
 
-from avar import datasets
-from avar.avlr import AvlrResult, avlr
-from avar.estimate import avar
-from avar.imu import IMU
-from avar.imu_avlr import ImuAvlrResult
-from avar.models import AR1, DR, QN, RW, WN, CompositeModel, NoiseModel
-from avar.nonstationary import covmat_ar1blocks, covmat_bi, covmat_nswn, moav, noav
-from avar.results import AllanVariance, ImuAllanVariance
-from avar.theory import av_ar1, av_dr, av_qn, av_rw, av_wn
+from __future__ import annotations
+
+import importlib
+from typing import Any
 
 __version__ = "0.1.0"
 
+#: Public name -> module that defines it.
+_EXPORTS = {
+    "IMU": "avar.imu",
+    "Recording": "avar.recording",
+    "read": "avar.io.read",
+    "AR1": "avar.models.processes",
+    "DR": "avar.models.processes",
+    "QN": "avar.models.processes",
+    "RW": "avar.models.processes",
+    "WN": "avar.models.processes",
+    "FN": "avar.models.flicker",
+    "CompositeModel": "avar.models.processes",
+    "NoiseModel": "avar.models.processes",
+    "av_ar1": "avar.models.theory",
+    "av_dr": "avar.models.theory",
+    "av_qn": "avar.models.theory",
+    "av_rw": "avar.models.theory",
+    "av_wn": "avar.models.theory",
+    "moav": "avar.models.nonstationary",
+    "noav": "avar.models.nonstationary",
+    "covmat_ar1blocks": "avar.models.covariance",
+    "covmat_bi": "avar.models.covariance",
+    "covmat_nswn": "avar.models.covariance",
+    "avar": "avar.stability.allan",
+    "AllanVariance": "avar.stability.results",
+    "ImuAllanVariance": "avar.stability.results",
+    "avlr": "avar.fit.avlr",
+    "AvlrResult": "avar.fit.results",
+    "ImuAvlrResult": "avar.fit.results",
+    "noise_report": "avar.fit.noise_report",
+    "NoiseReport": "avar.fit.report_result",
+    "auto_scales": "avar.fit.auto_scales",
+    "AutoScales": "avar.fit.auto_scales",
+    "gmwm": "avar.fit.gmwm",
+    "GmwmResult": "avar.fit.gmwm_results",
+    "ImuGmwmResult": "avar.fit.gmwm_results",
+    "select_model": "avar.fit.model_selection",
+    "plot_compare": "avar.plotting.compare",
+}
 
-def __getattr__(name: str):
-    # Plotting pulls in matplotlib: imported on first use, not with avar.
-    if name == "plot_compare":
-        from avar.plotting import plot_compare
+#: Public submodules reached as attributes (``avar.datasets.load(...)``).
+_SUBMODULES = {"datasets": "avar.io.datasets"}
 
-        return plot_compare
-    raise AttributeError(f"module 'avar' has no attribute {name!r}")
+__all__ = sorted([*_EXPORTS, *_SUBMODULES])
 
 
-__all__ = [
-    "AR1",
-    "DR",
-    "IMU",
-    "QN",
-    "RW",
-    "WN",
-    "AllanVariance",
-    "AvlrResult",
-    "CompositeModel",
-    "ImuAllanVariance",
-    "ImuAvlrResult",
-    "NoiseModel",
-    "av_ar1",
-    "av_dr",
-    "av_qn",
-    "av_rw",
-    "av_wn",
-    "avar",
-    "avlr",
-    "covmat_ar1blocks",
-    "covmat_bi",
-    "covmat_nswn",
-    "datasets",
-    "moav",
-    "noav",
-    "plot_compare",
-]
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(_EXPORTS[name]), name)
+    elif name in _SUBMODULES:
+        value = importlib.import_module(_SUBMODULES[name])
+    else:
+        raise AttributeError(f"module 'avar' has no attribute {name!r}")
+    globals()[name] = value  # later lookups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *__all__])

@@ -19,6 +19,7 @@ import pandas as pd
 
 from avar._validation import (
     EXACT_INTEGER_LIMIT,
+    as_array,
     check_finite,
     check_freq,
     check_length,
@@ -26,8 +27,6 @@ from avar._validation import (
     integer_range,
     rate_from_index,
 )
-from avar.estimate import allan_variance_columns, averaging_factors, n_differences, relative_errors
-from avar.results import AllanVariance, ImuAllanVariance
 
 GYROSCOPE = "Gyroscope"
 ACCELEROMETER = "Accelerometer"
@@ -47,14 +46,16 @@ TYPE_ALIASES = {
 
 
 def _frozen_matrix(values: np.ndarray) -> np.ndarray:
-    """A read-only float64 copy in column-major order (each channel contiguous)."""
+    """A read-only copy in column-major order (each channel contiguous).
+
+    float64, except for integers beyond 2**53, which float64 cannot hold
+    exactly: they are kept as they are (int64 or uint64), and the Allan
+    variance converts each channel without loss (see
+    :func:`avar._validation.as_float64`).
+    """
     bounds = integer_range(np.asarray(values))
-    if bounds is not None and max(abs(bounds[0]), abs(bounds[1])) > EXACT_INTEGER_LIMIT:
-        raise ValueError(
-            f"data holds integers up to {max(abs(bounds[0]), abs(bounds[1]))}, beyond 2**53, which float64 "
-            "cannot hold exactly; subtract an integer offset (e.g. the first sample) first"
-        )
-    matrix = np.array(values, dtype=np.float64, order="F", copy=True)
+    lossy = bounds is not None and max(abs(bounds[0]), abs(bounds[1])) > EXACT_INTEGER_LIMIT
+    matrix = np.array(values, dtype=np.asarray(values).dtype if lossy else np.float64, order="F", copy=True)
     matrix.flags.writeable = False
     return matrix
 
@@ -144,7 +145,7 @@ class IMU:
     ----------
     data : array_like of shape (N, C) or pandas.DataFrame
         Samples (rows) of every channel (columns), any real dtype; stored as a
-        read-only float64 copy. A DataFrame keeps its column names as channel
+        read-only float64 copy (integers beyond 2**53 keep their integer dtype). A DataFrame keeps its column names as channel
         names.
     freq : float
         Sampling frequency in Hz (> 0). See :meth:`from_dataframe` to take it
@@ -164,7 +165,8 @@ class IMU:
     Attributes
     ----------
     data : ndarray, shape (N, C)
-        Read-only float64 samples (column-major, each channel contiguous).
+        Read-only float64 samples (column-major, each channel contiguous); int64
+        or uint64 for integers beyond 2**53, which float64 cannot hold exactly.
     freq : float
         Sampling frequency in Hz.
     channels : tuple of str
@@ -230,12 +232,13 @@ class IMU:
             complex_ = [c for c, dt in zip(columns, data.dtypes) if pd.api.types.is_complex_dtype(dt)]
             if complex_:
                 raise TypeError(f"column(s) {complex_} of data are complex; the Allan variance needs real data")
-            array = data.to_numpy(dtype=np.float64, na_value=np.nan)
+            integers = all(pd.api.types.is_integer_dtype(dt) and dt.kind in "iu" for dt in data.dtypes)
+            array = data.to_numpy() if integers else data.to_numpy(dtype=np.float64, na_value=np.nan)
         else:
             if isinstance(data, pd.Series):
                 raise ValueError("data is a single Series; use avar.avar(series) for one channel, or give a DataFrame")
             columns = None
-            array = np.asarray(data)
+            array = as_array(data, "data")
         check_numeric_dtype(array, "data")
         if array.ndim != 2:
             raise ValueError(
@@ -354,64 +357,3 @@ class IMU:
 
     def __repr__(self) -> str:
         return f"<IMU {self.describe()}>"
-
-
-def imu_avar(imu: IMU, type: str, taus: Any) -> ImuAllanVariance:
-    """Allan variance of every channel of an IMU (use :func:`avar.avar`).
-
-    All channels share the tau grid and are computed in one pass of the
-    kernels over the (N, C) array; each channel's result equals
-    ``avar.avar(channel, type, freq, taus)``.
-
-    Parameters
-    ----------
-    imu : IMU
-    type : {"mo", "to"}
-        Estimator, already validated by :func:`avar.avar`.
-    taus : {"octave", "decade", "all"} or array_like of float
-        Tau grid; see :func:`avar.estimate.averaging_factors`.
-
-    Returns
-    -------
-    ImuAllanVariance
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import avar
-    >>> x = np.random.default_rng(3).standard_normal((4096, 2))
-    >>> res = avar.avar(IMU(x, freq=10, gyro=0, accel=1))
-    >>> res
-    <ImuAllanVariance IMU @ 10 Hz, N = 4096, 2 channels (Gyro. X, Accel. X)>
-    >>> res["Gyro. X"].levels[:3]
-    array([0.2, 0.4, 0.8])
-    """
-    n = imu.n
-    factors = averaging_factors(n, imu.freq, taus)
-    allan = allan_variance_columns(imu.data, factors, type)
-    levels = factors / imu.freq
-    errors = relative_errors(n, factors)
-    counts = n_differences(n, factors, type)
-    channels = {
-        name: AllanVariance(
-            levels=levels,
-            averaging_factors=factors,
-            allan=allan[j],
-            errors=errors,
-            n_differences=counts,
-            type=type,
-            freq=imu.freq,
-            n=n,
-            name=name,
-        )
-        for j, name in enumerate(imu.channels)
-    }
-    return ImuAllanVariance(
-        sensor=imu.name,
-        freq=imu.freq,
-        n=n,
-        channels=channels,
-        sensor_types=imu.sensor_types,
-        axes=imu.axes,
-        units=imu.units,
-    )

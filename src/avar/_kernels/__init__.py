@@ -6,8 +6,13 @@ tests check every kernel against a plain NumPy transcription.
 
 * :mod:`avar._kernels.allan`: the empirical Allan variance (compensated
   cumulative sums, squared second differences per level).
+* :mod:`avar._kernels.streaming`, :mod:`avar._kernels.levels`,
+  :mod:`avar._kernels.columns`: the streaming Allan variance behind the
+  plain-array entry point :func:`allan_variance_columns` (blocks of any real
+  dtype, a small reused workspace instead of O(N) arrays).
 * :mod:`avar._kernels.covariance`: the theoretical Allan variance of a
   covariance matrix (one validating pass, then O(n) per scale).
+* :mod:`avar._kernels.simulation`: recursions of the simulated processes.
 """
 
 import os
@@ -32,4 +37,6 @@ from avar._kernels.allan import (  # noqa: E402
     squared_difference_sums,
     task_sums,
 )
+from avar._kernels.columns import allan_variance_columns as streaming_allan_variance  # noqa: E402
 from avar._kernels.covariance import COV_TILE, NOAV_SCAN_RATIO, covariance_pass, moav_from_sums  # noqa: E402
+from avar._kernels.simulation import ar1_recursion  # noqa: E402

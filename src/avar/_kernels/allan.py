@@ -55,7 +55,7 @@ FUSED_BLOCK = 1 << 16
 FUSED_MAX_LEVELS = 128
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, nogil=True)
 def column_moments(data, block=CUMSUM_BLOCK):
     """Mean, minimum and maximum of every column of ``data`` (N, C) in one pass.
 
@@ -107,7 +107,7 @@ def _centred(xi, ctr, sc):
     return yh * sc, yl * sc
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, nogil=True)
 def centred_cumsum(data, centre, scale, hi, lo, block=CUMSUM_BLOCK):
     """Fill ``hi``, ``lo`` with compensated cumulative sums of ``(data[:, c] - centre[c]) * scale[c]``.
 
@@ -218,7 +218,7 @@ def _strided_squares(hi, lo, m, stride, start, count, buffer):
     return _sum(buffer, count)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, nogil=True)
 def fused_overlapping_sums(hi, lo, factors, n_differences, block=FUSED_BLOCK):
     """Maximal-overlap sums of all levels, one time block per task.
 
@@ -251,7 +251,7 @@ def fused_overlapping_sums(hi, lo, factors, n_differences, block=FUSED_BLOCK):
     return out
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, nogil=True)
 def task_sums(hi, lo, task_channel, task_factor, task_stride, task_first, task_last):
     """Evaluate every task's sum of squared second differences in parallel.
 

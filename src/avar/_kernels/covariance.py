@@ -1,13 +1,13 @@
 """Theoretical Allan variance of a covariance matrix (moav, noav), in numba.
 
-One pass over a T x T covariance matrix C (used by avar.nonstationary) that
+One pass over a T x T covariance matrix C (used by avar.models.nonstationary) that
 checks it (finite, symmetric) and, in the same visit of each row, gathers
 what the theoretical MOAV / NOAV need. Two tasks share the work: the top
 one walks rows 0, 1, ... and the bottom one rows T - 1, T - 2, ...; the
 split of the symmetry check between them is fixed by the tile size only,
 so results do not depend on the number of threads.
 
-MOAV (see avar.nonstationary for the derivation). With the diagonals
+MOAV (see avar.models.nonstationary for the derivation). With the diagonals
 c_d(i) = C[i, i + d], each centred on its middle element beta_d, the sum
 over windows of w' C_s w (w = -1 x n, +1 x n) is
 
@@ -23,7 +23,7 @@ bottom-right one turned onto it),
   Q2[q] = sum_{x + d = q} mult_d H[x, d]
   R[x]  = sum_{d <= x} mult_d H[x, d]
 
-(the three ramps of the weight of a corner entry, see avar.nonstationary).
+(the three ramps of the weight of a corner entry, see avar.models.nonstationary).
 The pass yields beta, D, Q1, Q2, R for d, q < 2 max(n); each scale then
 costs O(n). NOAV sums the upper triangle of the disjoint diagonal blocks
 row by row (each row of a block is two or three segment sums).

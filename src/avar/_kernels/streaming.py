@@ -1,0 +1,265 @@
+"""Streaming Allan variance kernels (numba): blocks of the series, a small reused workspace.
+
+Nothing here validates input. The entry point is
+:func:`avar._kernels.streaming_allan_variance`; it calls these kernels on any
+real (N, C) array (float64, float32, any integer dtype, any memory layout,
+memory-mapped) without converting it to float64 as a whole.
+
+How it works
+------------
+Both estimators are sums of ``D**2`` with ``D = S[b+2m] - 2 S[b+m] + S[b]``
+and ``S`` the cumulative sum of the centred series (see :mod:`allan`). The
+full ``S`` (12 bytes a sample) is never stored:
+
+1. one pass sums every block of ``BLOCK`` samples (compensated, exact for
+   64-bit integers, which are split as ``hi * 2**32 + lo``) and finds the
+   largest magnitude; an exact double-double scan of the block sums gives the
+   centred ``S`` at every block boundary (the *table*, N / BLOCK entries);
+2. "to": one more pass. Each time block rebuilds its ``S`` values in a small
+   buffer from the table, and every level reads ``S`` at its cluster
+   boundaries from it, carrying the last two boundaries' values across blocks;
+3. "mo": levels with ``m <= NEAR`` read a sliding window of ``S`` (the
+   block plus a halo of ``2 NEAR``) computed once per block; each larger level
+   rebuilds ``S`` on the block shifted by ``m`` and ``2 m`` from the table
+   (for octave grids the ``2 m`` region of one level is the ``m`` region of
+   the next, so the input is read about once per large level).
+
+Every ``S`` value is anchored at the exactly scanned table and accumulated
+with TwoSum (``hi + lo``), so the differences keep the accuracy of the old
+full cumulative sum. Work is split into (column, chunk of ``CHUNK_BLOCKS``
+blocks) tasks whose sums are added in a fixed order: the bits do not depend
+on the number of threads.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange, types
+from numba.extending import overload
+
+#: Samples per block: table granularity and differences per inner step.
+BLOCK = 4096
+
+#: Largest cluster size served by the sliding near window ("mo").
+NEAR = 4096
+
+#: Blocks per parallel task (fixes the summation order).
+CHUNK_BLOCKS = 64
+
+#: Length of the sliding near window: halo plus four blocks.
+NEAR_LEN = 2 * NEAR + 4 * BLOCK
+
+#: Magnitudes outside [2**-LIMIT_EXP, 2**LIMIT_EXP] are rescaled by a power of two.
+LIMIT_EXP = 400
+
+
+@njit(cache=True, inline="always")
+def _two_sum(a, b):
+    s = a + b
+    bv = s - a
+    e = (a - (s - bv)) + (b - bv)
+    return s, e
+
+
+@njit(cache=True, inline="always")
+def _fast_two_sum(a, b):
+    s = a + b
+    return s, b - (s - a)
+
+
+def _centred(x, c, sc):  # pragma: no cover - replaced by the overload in compiled code
+    raise NotImplementedError
+
+
+@overload(_centred, inline="always")
+def _centred_overload(x, c, sc):
+    """``x * sc - c`` as an exact pair ``(hi, lo)``; 64-bit integers split in two halves."""
+    if isinstance(x, types.Integer) and x.bitwidth == 64:
+        if x.signed:
+
+            def impl(x, c, sc):
+                a = np.float64(x >> 32) * 4294967296.0
+                b = np.float64(x & 0xFFFFFFFF)
+                s1, e1 = _two_sum(a, -c)
+                s2, e2 = _two_sum(s1, b)
+                return s2, e1 + e2
+
+        else:
+
+            def impl(x, c, sc):
+                a = np.float64(x >> np.uint64(32)) * 4294967296.0
+                b = np.float64(x & np.uint64(0xFFFFFFFF))
+                s1, e1 = _two_sum(a, -c)
+                s2, e2 = _two_sum(s1, b)
+                return s2, e1 + e2
+
+        return impl
+
+    def impl(x, c, sc):
+        return _two_sum(np.float64(x) * sc, -c)
+
+    return impl
+
+
+@njit(cache=True)
+def _block_sum(data, col, start, stop, scale):
+    """Compensated sum of ``data[start:stop, col] * scale`` and the largest magnitude."""
+    total = 0.0
+    comp = 0.0
+    big = 0.0
+    x = data[start:stop, col]
+    for i in range(stop - start):
+        yh, yl = _centred(x[i], 0.0, scale)
+        big = max(big, abs(yh))
+        total, e = _two_sum(total, yh)
+        comp += e + yl
+    return total, comp, big
+
+
+@njit(cache=True)
+def _table_column(bh, bl, n, block, integral, out_hi, out_lo):
+    """Exact (double-double) prefix of block sums, then centred on their mean.
+
+    An integer series gets an integer centre: every centred value, and so
+    every sum, is then an integer held exactly by the (hi, lo) pairs.
+    Returns the centre; fills ``out_hi/out_lo[k]`` with the centred ``S[k block]``.
+    """
+    nb = bh.shape[0]
+    th = np.empty(nb + 1)
+    tl = np.empty(nb + 1)
+    th[0] = 0.0
+    tl[0] = 0.0
+    h = 0.0
+    lo = 0.0
+    for k in range(nb):
+        s, e = _two_sum(h, bh[k])
+        e += lo + bl[k]
+        h, lo = _fast_two_sum(s, e)
+        th[k + 1] = h
+        tl[k + 1] = lo
+    centre = (h + lo) / n
+    if integral:
+        centre = np.round(centre)
+    # Dekker split of the centre for exact products p * centre.
+    big = centre * 134217729.0
+    c_hi = big - (big - centre)
+    c_lo = centre - c_hi
+    for k in range(nb + 1):
+        p = np.float64(min(k * block, n))
+        ph = p * centre
+        # exact error of p * centre (p < 2**53 is split the same way)
+        bp = p * 134217729.0
+        p_hi = bp - (bp - p)
+        p_lo = p - p_hi
+        pe = ((p_hi * c_hi - ph) + p_hi * c_lo + p_lo * c_hi) + p_lo * c_lo
+        s, e = _two_sum(th[k], -ph)
+        e += tl[k] - pe
+        out_hi[k], out_lo[k] = _fast_two_sum(s, e)
+    return centre
+
+
+@njit(cache=True, parallel=True)
+def block_table(data, scale, integral, block=BLOCK):
+    """Pass 1 over all columns: returns (table_hi, table_lo, centre, maxabs).
+
+    ``table_*`` have shape (C, ceil(N / block) + 1) with the centred
+    cumulative sum of ``data * scale`` at every block boundary (and at N).
+    """
+    n, channels = data.shape
+    nb = (n + block - 1) // block
+    bh = np.empty((channels, nb))
+    bl = np.empty((channels, nb))
+    bm = np.empty((channels, nb))
+    for task in prange(channels * nb):
+        c = task // nb
+        b = task % nb
+        bh[c, b], bl[c, b], bm[c, b] = _block_sum(data, c, b * block, min(n, (b + 1) * block), scale[c])
+    return _finish_table(bh, bl, bm, n, block, integral)
+
+
+@njit(cache=True)
+def block_table_serial(data, scale, integral, block=BLOCK):
+    """:func:`block_table` on one thread (small inputs: no thread start-up)."""
+    n, channels = data.shape
+    nb = (n + block - 1) // block
+    bh = np.empty((channels, nb))
+    bl = np.empty((channels, nb))
+    bm = np.empty((channels, nb))
+    for task in range(channels * nb):
+        c = task // nb
+        b = task % nb
+        bh[c, b], bl[c, b], bm[c, b] = _block_sum(data, c, b * block, min(n, (b + 1) * block), scale[c])
+    return _finish_table(bh, bl, bm, n, block, integral)
+
+
+@njit(cache=True)
+def _finish_table(bh, bl, bm, n, block, integral):
+    channels, nb = bh.shape
+    table_hi = np.empty((channels, nb + 1))
+    table_lo = np.empty((channels, nb + 1))
+    centre = np.empty(channels)
+    maxabs = np.empty(channels)
+    for c in range(channels):
+        centre[c] = _table_column(bh[c], bl[c], n, block, integral, table_hi[c], table_lo[c])
+        maxabs[c] = bm[c].max() if nb > 0 else 0.0
+    return table_hi, table_lo, centre, maxabs
+
+
+@njit(cache=True)
+def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at):
+    """``out[at + i] = S[start + i]`` for ``i = 0 .. stop - start`` from ``S[start] = (s_hi, s_lo)``.
+
+    (Loops run over slices with ``range(count)``: non-negative indices, so
+    numba emits no wraparound checks and LLVM can vectorize the loads.)
+    """
+    count = stop - start
+    x = data[start:stop, col]
+    oh = out_hi[at + 1 : at + 1 + count]
+    ol = out_lo[at + 1 : at + 1 + count]
+    total = s_hi
+    comp = s_lo
+    out_hi[at] = total
+    out_lo[at] = comp
+    for i in range(count):
+        yh, yl = _centred(x[i], centre, scale)
+        total, e = _two_sum(total, yh)
+        comp += e + yl
+        oh[i] = total
+        ol[i] = comp
+
+
+@njit(cache=True)
+def point(data, col, p, centre, scale, table_hi, table_lo, block):
+    """Centred ``S[p]`` as ``(hi, lo)``: the table entry below ``p`` plus a partial block."""
+    q = p // block
+    total = table_hi[col, q]
+    comp = table_lo[col, q]
+    x = data[q * block : p, col]
+    for i in range(p - q * block):
+        yh, yl = _centred(x[i], centre, scale)
+        total, e = _two_sum(total, yh)
+        comp += e + yl
+    return total, comp
+
+
+@njit(cache=True, fastmath=True)
+def _fast_sum(buffer, count):
+    total = 0.0
+    for j in range(count):
+        total += buffer[j]
+    return total
+
+
+@njit(cache=True)
+def squares(h0, l0, a0, h1, l1, a1, h2, l2, a2, count, buffer):
+    """Sum over ``j < count`` of ``D_j**2`` from three windows of ``S`` (compensated differences)."""
+    x0 = h0[a0 : a0 + count]
+    x1 = h1[a1 : a1 + count]
+    x2 = h2[a2 : a2 + count]
+    y0 = l0[a0 : a0 + count]
+    y1 = l1[a1 : a1 + count]
+    y2 = l2[a2 : a2 + count]
+    for j in range(count):
+        d = ((x2[j] - x1[j]) - (x1[j] - x0[j])) + ((y2[j] - y1[j]) - (y1[j] - y0[j]))
+        buffer[j] = d * d
+    return _fast_sum(buffer, count)

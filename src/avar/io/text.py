@@ -1,0 +1,274 @@
+"""Text tables: CSV, TSV, semicolon (decimal commas), whitespace-separated columns.
+
+The layout is sniffed from the first lines (a UTF-8 byte-order mark is not data); the
+numbers are parsed by pandas' C engine in one pass, never cell by cell in Python:
+
+* the separator: ``;``, tab, ``,`` or runs of whitespace;
+* the header: a first line that is not all numbers, or a ``#`` comment line just before
+  the data with one name per column (``# time gx gy``, as ``numpy.savetxt`` writes);
+  without one, columns are ``x`` (one column) or ``x1, x2, ...``;
+* decimal commas (``0,5``) when the separator is not a comma;
+* a trailing separator on every line adds no column.
+
+Integer columns stay int64, exact even beyond 2**53. Cells that are not numbers are
+reported with their row and line (clipped to a readable length).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+#: Bytes sniffed for the layout.
+SNIFF_BYTES = 1 << 16
+#: Longest excerpt of a cell or line quoted in a message.
+QUOTE_LIMIT = 200
+_NUMBER = re.compile(r"[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?|[-+]?(nan|inf|infinity)", re.I)
+_DECIMAL_COMMA = re.compile(r"\d,\d")
+
+
+def clip(value: object, limit: int = QUOTE_LIMIT) -> str:
+    """``repr(value)``, cut to about ``limit`` characters with the full length said."""
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    length = len(value) if isinstance(value, (str, list, tuple)) else len(text)
+    return f"{text[:limit]}... ({length} {'characters' if isinstance(value, str) else 'items'})"
+
+
+class Layout:
+    """What the first lines of a text table say about it."""
+
+    def __init__(
+        self, separator: str, decimal: str, names: list[str], header_row: bool, skip: int, trailing: bool = False
+    ) -> None:
+        self.separator = separator  # ";", "\t", ",", or r"\s+"
+        self.trailing = trailing  # whether lines end with a separator (an empty last field)
+        self.decimal = decimal
+        self.names = names  # column names when they are not read from a header row
+        self.header_row = header_row  # whether pandas reads the names from the first line after `skip`
+        self.skip = skip  # lines before the header row (or the first data row)
+
+    @property
+    def first_data_line(self) -> int:
+        """1-based file line of the first data row."""
+        return self.skip + (2 if self.header_row else 1)
+
+
+def _split(line: str, separator: str) -> list[str]:
+    if separator == r"\s+":
+        return line.split()
+    return [token.strip() for token in next(csv.reader([line], delimiter=separator))]
+
+
+def _is_number(token: str) -> bool:
+    return bool(_NUMBER.fullmatch(token.strip().strip('"')))
+
+
+def sniff(path: Path) -> Layout:
+    """The separator, decimal mark and header of a text table, from its first lines."""
+    with path.open("r", encoding="utf-8-sig", errors="replace", newline="") as handle:
+        sample = handle.read(SNIFF_BYTES)
+    lines = sample.splitlines()
+    if len(sample) == SNIFF_BYTES and len(lines) > 1:
+        lines = lines[:-1]  # the last line may be cut
+    skip, comment = 0, None
+    while skip < len(lines) and (not lines[skip].strip() or lines[skip].lstrip().startswith("#")):
+        if lines[skip].strip():
+            comment = lines[skip].lstrip()[1:].strip()
+        skip += 1
+    if skip == len(lines):
+        raise ValueError("the file holds no data (only blank or # comment lines)")
+    first = lines[skip]
+    if ";" in first:
+        separator = ";"
+    elif "\t" in first:
+        separator = "\t"
+    elif "," in first and not re.fullmatch(r"\s*[-+]?\d+,\d+([eE][-+]?\d+)?(\s+[-+]?\d+,\d+([eE][-+]?\d+)?)+\s*", first):
+        separator = ","
+    else:
+        separator = r"\s+"
+    data_lines = "\n".join(lines[skip:])
+    decimal = "," if separator != "," and _DECIMAL_COMMA.search(data_lines) else "."
+    tokens = _split(first, separator)
+    trailing = len(tokens) > 1 and tokens[-1] == "" and separator != r"\s+"
+    if trailing:
+        tokens.pop()  # a separator at the end of the line
+    if all(_is_number(token) for token in tokens if token):
+        names = None
+        if comment is not None:
+            candidate = _split(comment, separator)
+            if len(candidate) == len(tokens) and not all(_is_number(token) for token in candidate):
+                names = candidate  # "# time gx gy" written by numpy.savetxt
+        if names is None:
+            names = [f"x{i + 1}" for i in range(len(tokens))] if len(tokens) > 1 else ["x"]
+        return Layout(separator, decimal, names, header_row=False, skip=skip, trailing=trailing)
+    names = [token.strip('"') for token in tokens]
+    return Layout(separator, decimal, names, header_row=True, skip=skip, trailing=trailing)
+
+
+def _check_names(names: list[str], path: Path) -> list[str]:
+    names = [str(name).strip() for name in names]
+    empty = [i + 1 for i, name in enumerate(names) if not name]
+    if empty:
+        raise ValueError(f"{path}: column(s) {empty} of the header have no name; name every column")
+    seen = {name for name in names if names.count(name) > 1}
+    if seen:
+        raise ValueError(f"{path}: duplicate column names {sorted(seen)} in the header; names must be distinct")
+    return names
+
+
+#: Rows parsed per chunk: the columns are filled chunk by chunk into arrays sized once, so the
+#: peak memory is the columns plus one chunk (pandas alone holds the table about three times).
+CHUNK_ROWS = 1 << 18
+_COUNT_BLOCK = 1 << 24
+
+
+def count_lines(path: Path) -> int:
+    """Newlines in the file (an upper bound of its rows, less one)."""
+    count = 0
+    with path.open("rb") as handle:
+        while block := handle.read(_COUNT_BLOCK):
+            count += block.count(b"\n")
+    return count
+
+
+class _Columns:
+    """Column arrays allocated once and filled chunk by chunk; a column's type widens if a chunk needs it.
+
+    int64 stays int64 (exact); ints and floats widen to float64; a chunk of text (decimal
+    commas, date-times, a bad cell) turns the column into an object array for
+    :func:`numeric_column` to convert or report.
+    """
+
+    def __init__(self, capacity: int) -> None:
+        self.capacity = max(capacity, 1)
+        self.arrays: dict[str, np.ndarray] = {}
+        self.n = 0
+
+    @staticmethod
+    def _kind(values: np.ndarray) -> str:
+        return values.dtype.kind if values.dtype.kind in "iuf" else "O"
+
+    def add(self, chunk: pd.DataFrame) -> None:
+        rows = len(chunk)
+        if self.n + rows > self.capacity:  # more rows than newlines counted (e.g. a file still growing)
+            self.capacity = max(2 * self.capacity, self.n + rows)
+            for name, array in self.arrays.items():
+                grown = np.empty(self.capacity, dtype=array.dtype)
+                grown[: self.n] = array[: self.n]
+                self.arrays[name] = grown
+        for name in chunk.columns:
+            values = chunk[name].to_numpy()
+            kind = self._kind(values)
+            target = self.arrays.get(name)
+            if target is None:
+                dtype = {"i": np.int64, "u": np.uint64, "f": np.float64, "O": object}[kind]
+                target = self.arrays[name] = np.empty(self.capacity, dtype=dtype)
+            elif kind != self._kind(target):
+                wider = object if "O" in (kind, self._kind(target)) else np.float64
+                if target.dtype != wider:
+                    target = self.arrays[name] = target.astype(wider)
+            target[self.n : self.n + rows] = values
+        self.n += rows
+
+    def finish(self) -> dict[str, np.ndarray]:
+        """The filled rows, without the blank lines that end the file."""
+        arrays = {name: array[: self.n] for name, array in self.arrays.items()}
+        last = self.n
+        window = 4096
+        while last > 0:
+            start = max(0, last - window)
+            filled = np.zeros(last - start, dtype=bool)
+            for array in arrays.values():
+                filled |= ~pd.isna(array[start:last])
+            if filled.any():
+                last = start + int(np.flatnonzero(filled)[-1]) + 1
+                break
+            last, window = start, window * 4
+        return {name: array[:last] for name, array in arrays.items()}
+
+
+def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[dict[str, np.ndarray], Layout]:
+    """The table's columns as arrays (numbers where they parse, else text), and its layout.
+
+    ``stream`` (the opened file, e.g. wrapped by a progress bar) is read instead of
+    ``path`` when given.
+    """
+    layout = sniff(path)
+    names = _check_names(layout.names, path)
+    extra = "\0trailing separator"
+    columns = _Columns(count_lines(path) + 1 - layout.skip)
+    try:
+        with pd.read_csv(
+            stream if stream is not None else path,
+            sep=layout.separator,
+            decimal=layout.decimal,
+            header=None,
+            names=[*names, extra] if layout.trailing else names,
+            skiprows=layout.skip + (1 if layout.header_row else 0),
+            index_col=False,
+            engine="c",
+            encoding="utf-8-sig",
+            skip_blank_lines=False,  # a blank line inside the data is a missing sample, not nothing
+            quotechar='"',
+            chunksize=CHUNK_ROWS,
+        ) as chunks:
+            for chunk in chunks:
+                if layout.trailing:
+                    spill = chunk[extra].notna().to_numpy()
+                    if spill.any():
+                        row = columns.n + int(np.flatnonzero(spill)[0])
+                        raise ValueError(
+                            f"{path}: line {row + layout.first_data_line} has a value after the last column "
+                            f"({clip(str(chunk[extra].to_numpy()[spill][0]))}); every line must have the "
+                            f"header's {len(names)} columns"
+                        )
+                    chunk = chunk.drop(columns=extra)
+                columns.add(chunk)
+    except pd.errors.EmptyDataError:
+        raise ValueError(f"{path}: the file holds a header but no data") from None
+    except (pd.errors.ParserError, UnicodeDecodeError) as error:
+        message = clip(str(error).splitlines()[0] if str(error) else type(error).__name__)
+        raise ValueError(f"{path}: not a readable CSV/text table ({message})") from None
+    if not columns.arrays:
+        raise ValueError(f"{path}: the file holds a header but no data")
+    return columns.finish(), layout
+
+
+def numeric_column(column: np.ndarray, name: str, layout: Layout, path: Path) -> np.ndarray:
+    """A column as float64 or int64 (exact), with the first cell that is not a number named."""
+    if column.dtype.kind in "iuf":
+        values = column
+    elif column.dtype.kind == "b":
+        raise ValueError(f"{path}: column {name!r} holds true/false values, not numbers")
+    else:
+        column = pd.Series(column, copy=False)
+        text = column.astype("string").str.strip()
+        if layout.separator != ",":  # decimal commas that appear only after integer rows
+            text = text.str.replace(",", ".", regex=False)
+        parsed = pd.to_numeric(text, errors="coerce")
+        bad = (parsed.isna() & text.notna()).to_numpy()
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            cell = str(column.iloc[row])
+            what = "a number beyond the float64 range" if _is_number(cell) else clip(cell)
+            raise ValueError(
+                f"{path}: column {name!r} is not numeric: row {row + 1} (line {row + layout.first_data_line}) "
+                f"holds {what}{f' ({clip(cell, 40)})' if _is_number(cell) else ''}"
+            )
+        values = parsed.to_numpy(dtype=np.float64, na_value=np.nan)
+    if values.dtype.kind == "f":
+        missing = ~np.isfinite(values)
+        if missing.any():
+            row = int(np.flatnonzero(missing)[0])
+            raise ValueError(
+                f"{path}: column {name!r} has {int(missing.sum())} missing or non-finite value(s); the first is in "
+                f"row {row + 1} (line {row + layout.first_data_line}); fill or cut them"
+            )
+    return values

@@ -1,0 +1,20 @@
+"""Matplotlib figures of every result; reached through the results' ``.plot()``
+methods, :func:`avar.plot_compare` and the command line.
+
+* :mod:`avar.plotting.base`: argument checks, colours, log axes, bands, fit lines;
+* :mod:`avar.plotting.single`: one Allan variance (:func:`plot_avar`) and its
+  AVLR fit (:func:`plot_avlr`);
+* :mod:`avar.plotting.imu`: the grids of IMU results;
+* :mod:`avar.plotting.compare`: several Allan variances on one axes;
+* :mod:`avar.plotting.report`: the noise-report figure (``NoiseReport.plot()``).
+* :mod:`avar.plotting.gmwm`: GMWM fits (:func:`plot_gmwm`, :func:`plot_imu_gmwm`).
+"""
+
+from avar.plotting.compare import plot_compare
+from avar.plotting.gmwm import plot_gmwm, plot_imu_gmwm
+from avar.plotting.imu import plot_imu_avar, plot_imu_avlr
+from avar.plotting.report import plot_report
+from avar.plotting.single import plot_avar, plot_avlr
+
+__all__ = ["plot_avar", "plot_avlr", "plot_compare", "plot_gmwm", "plot_imu_avar", "plot_imu_avlr", "plot_imu_gmwm",
+           "plot_report"]

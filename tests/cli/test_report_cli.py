@@ -1,0 +1,91 @@
+"""``avar report``, run for real in subprocesses on files written to disk."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from avar.models import FN, RW, WN
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+FREQ = 50.0
+DEG = math.pi / 180
+
+
+def run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "avar", "report", *args], capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def imu_file(tmp_path_factory):
+    """A CSV log: time, three gyros in deg/s and three accelerometers in g, 1 hour at 50 Hz."""
+    n = int(3600 * FREQ)
+    gyro = WN.from_continuous(3e-3, FREQ) + FN.from_continuous(2e-3, FREQ) + RW.from_continuous(3e-4, FREQ)
+    accel = WN.from_continuous(2e-5, FREQ) + FN.from_continuous(1.5e-5, FREQ) + RW.from_continuous(2e-6, FREQ)
+    rng = np.random.default_rng(5)
+    columns = {"time": np.arange(n) / FREQ}
+    columns |= {f"g{a}": gyro.simulate(n, seed=rng) for a in "xyz"}
+    columns |= {f"a{a}": accel.simulate(n, seed=rng) for a in "xyz"}
+    path = tmp_path_factory.mktemp("log") / "imu.csv"
+    pd.DataFrame(columns).to_csv(path, index=False, float_format="%.10g")
+    return path
+
+
+def test_one_command_writes_yaml_figure_and_table(imu_file, tmp_path):
+    yaml_path, png, csv = tmp_path / "imu.yaml", tmp_path / "report.png", tmp_path / "terms.csv"
+    result = run(str(imu_file), "--gyro", "gx", "gy", "gz", "--accel", "ax", "ay", "az", "--gyro-units", "deg/s",
+                 "--accel-units", "g", "--topic", "/imu0", "--kalibr", str(yaml_path), "--plot", str(png),
+                 "--output", str(csv))
+    assert result.returncode == 0, result.stderr
+    assert "Angle random walk" in result.stdout and "deg/sqrt(h)" in result.stdout
+    assert "Bias instability" in result.stdout and "ug" in result.stdout
+    assert f"Wrote {yaml_path}" in result.stdout
+    fields = yaml.safe_load(yaml_path.read_text())
+    assert fields["rostopic"] == "/imu0" and fields["update_rate"] == pytest.approx(FREQ, rel=1e-9)
+    assert fields["gyroscope_noise_density"] == pytest.approx(3e-3 * DEG, rel=0.03)
+    assert fields["accelerometer_noise_density"] == pytest.approx(2e-5 * 9.80665, rel=0.03)
+    assert png.read_bytes()[:8] == PNG_MAGIC
+    table = pd.read_csv(csv)
+    assert len(table) == 6 * 5 and set(table["Channel"]) == {"gx", "gy", "gz", "ax", "ay", "az"}
+    wn = table[(table["Channel"] == "gx") & (table["Process"] == "WN")].iloc[0]
+    assert wn["Customary"] == pytest.approx(3e-3 * 60, rel=0.03)  # deg/sqrt(h)
+    absent = table[table["Status"] == "absent"]
+    assert absent["Value"].isna().all() and not absent.empty  # empty cells, never the text "nan"
+    assert "nan" not in csv.read_text().lower()
+
+
+def test_columns_are_found_by_name(imu_file):
+    result = run(str(imu_file), "--gyro-units", "deg/s")
+    assert result.returncode == 0, result.stderr
+    assert "gx (gyroscope)" in result.stdout and "az (accelerometer)" in result.stdout
+
+
+def test_outputs_are_safe(imu_file, tmp_path):
+    existing = tmp_path / "imu.yaml"
+    existing.write_text("keep\n")
+    result = run(str(imu_file), "--kalibr", str(existing))
+    assert result.returncode == 2 and "--force" in result.stderr
+    assert existing.read_text() == "keep\n"
+    result = run(str(imu_file), "--kalibr", str(existing), "--force")
+    assert result.returncode == 0, result.stderr
+    assert yaml.safe_load(existing.read_text())["rostopic"] == "/imu0"
+    result = run(str(imu_file), "--output", str(imu_file))
+    assert result.returncode == 2 and "input file" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["imu.yaml"]  # no temporary file left
+
+
+def test_errors_are_one_line(tmp_path):
+    path = tmp_path / "x.csv"
+    pd.DataFrame({"gx": np.random.default_rng(1).standard_normal(1000)}).to_csv(path, index=False)
+    result = run(str(path))
+    assert result.returncode == 1 and "--freq" in result.stderr and "Traceback" not in result.stderr
+    result = run(str(path), "--freq", "100", "--gyro-units", "rpm")
+    assert result.returncode == 2
+    result = run(str(tmp_path / "missing.csv"), "--freq", "100")
+    assert result.returncode == 1 and "no such file" in result.stderr

@@ -1,0 +1,92 @@
+"""Tests of the Kalibr imu.yaml export: written with PyYAML and read back."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+import avar
+from avar.models import FN, RW, WN
+
+FREQ = 100.0
+N_SAMPLES = 360_000
+G0 = 9.80665
+DEG = math.pi / 180
+# gyro in deg/s, accel in g; each term dominates a decade or more of the hour
+GYRO = {"N": 3e-3, "B": 2e-3, "K": 3e-4}
+ACCEL = {"N": 2e-5, "B": 1.5e-5, "K": 2e-6}
+
+
+def model(truth):
+    return (WN.from_continuous(truth["N"], FREQ) + FN.from_continuous(truth["B"], FREQ)
+            + RW.from_continuous(truth["K"], FREQ))
+
+
+@pytest.fixture(scope="module")
+def recording():
+    rng = np.random.default_rng(21)
+    columns = {f"gyro_{a}": model(GYRO).simulate(N_SAMPLES, seed=rng) for a in "xyz"}
+    columns |= {f"acc_{a}": model(ACCEL).simulate(N_SAMPLES, seed=rng) for a in "xyz"}
+    return SimpleNamespace(columns=pd.DataFrame(columns), freq=FREQ, topic="/imu0/data", source="flight.bag")
+
+
+@pytest.fixture(scope="module")
+def report(recording):
+    return avar.noise_report(recording, gyro_units="deg/s", accel_units="g")
+
+
+def test_kalibr_yaml_holds_the_simulated_densities_in_si(report, tmp_path):
+    path = report.to_kalibr(tmp_path / "imu.yaml")
+    fields = yaml.safe_load(path.read_text())
+    assert list(fields) == ["gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
+                            "accelerometer_random_walk", "rostopic", "update_rate"]
+    assert fields["gyroscope_noise_density"] == pytest.approx(GYRO["N"] * DEG, rel=0.03)
+    assert fields["gyroscope_random_walk"] == pytest.approx(GYRO["K"] * DEG, rel=0.15)
+    assert fields["accelerometer_noise_density"] == pytest.approx(ACCEL["N"] * G0, rel=0.03)
+    assert fields["accelerometer_random_walk"] == pytest.approx(ACCEL["K"] * G0, rel=0.15)
+    assert fields["rostopic"] == "/imu0/data"
+    assert fields["update_rate"] == 100.0
+
+
+def test_densities_are_the_mean_over_axes(report):
+    fields = report.kalibr()
+    gyro_wn = [report.value(f"gyro_{a}", "WN") for a in "xyz"]
+    assert fields["gyroscope_noise_density"] == pytest.approx(np.mean(gyro_wn), rel=1e-14)
+    acc_rw = [report.value(f"acc_{a}", "RW") for a in "xyz"]
+    assert fields["accelerometer_random_walk"] == pytest.approx(np.mean(acc_rw), rel=1e-14)
+
+
+def test_topic_rate_and_overrides(report, recording, tmp_path):
+    fields = report.kalibr(rostopic="/other", update_rate=200, gyroscope_random_walk=1e-5)
+    assert (fields["rostopic"], fields["update_rate"], fields["gyroscope_random_walk"]) == ("/other", 200.0, 1e-5)
+    plain = avar.noise_report(recording.columns[["gyro_x"]], gyro_units="deg/s", freq=FREQ)
+    assert plain.kalibr()["rostopic"] == "/imu0"  # Kalibr's example topic when not from a bag
+    assert list(plain.kalibr()) == ["gyroscope_noise_density", "gyroscope_random_walk", "rostopic", "update_rate"]
+    with pytest.raises(TypeError, match="unknown Kalibr field"):
+        report.kalibr(gyro_noise=1.0)
+
+
+def test_existing_file_is_refused_and_nothing_half_written(report, tmp_path):
+    path = tmp_path / "imu.yaml"
+    path.write_text("keep me\n")
+    with pytest.raises(FileExistsError, match="force"):
+        report.to_kalibr(path)
+    assert path.read_text() == "keep me\n"
+    report.to_kalibr(path, force=True)
+    assert yaml.safe_load(path.read_text())["update_rate"] == 100.0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["imu.yaml"]  # no temporary left behind
+
+
+def test_absent_random_walk_is_an_error_not_a_zero():
+    x = WN(sigma2=1e-4).simulate(50_000, seed=1)
+    rep = avar.noise_report(x, gyro_units="rad/s", freq=100.0)
+    with pytest.raises(ValueError, match="gyroscope_random_walk"):
+        rep.kalibr()
+    assert rep.kalibr(gyroscope_random_walk=1e-6)["gyroscope_random_walk"] == 1e-6
+    with pytest.raises(ValueError, match="no gyroscope or accelerometer"):
+        avar.noise_report(x, freq=100.0).kalibr()

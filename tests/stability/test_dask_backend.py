@@ -1,0 +1,55 @@
+"""The Dask backend against the NumPy (streaming kernel) path."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+da = pytest.importorskip("dask.array")
+distributed = pytest.importorskip("dask.distributed")
+
+from avar._kernels import streaming_allan_variance as allan_variance_columns  # noqa: E402
+from avar.stability.dask_backend import allan_variance_dask, allan_variance_files  # noqa: E402
+
+
+def octave(n):
+    return 2 ** np.arange(1, n.bit_length() - 1, dtype=np.int64)
+
+
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_sixteen_chunks_match_numpy_path(type):
+    n = 1_000_000
+    x = 1e3 + np.cumsum(np.random.default_rng(1).standard_normal(n))
+    factors = np.concatenate((octave(n), [3, 1000, 77_777]))
+    want = allan_variance_columns(x, factors, type)
+    got = allan_variance_dask(da.from_array(x, chunks=n // 16), factors, type)
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+
+
+def test_uneven_chunks_columns_and_invalid_factors():
+    x = np.random.default_rng(2).standard_normal((5003, 2)).astype(np.float32)
+    factors = np.array([1, 2, 7, 2502, 2501], dtype=np.int64)
+    for type in ("mo", "to"):
+        want = allan_variance_columns(x, factors, type)
+        got = allan_variance_dask(da.from_array(x, chunks=(777, 2)), factors, type)
+        np.testing.assert_allclose(got, want, rtol=1e-12)
+        assert np.isnan(got[:, 3]).all()
+
+
+def test_local_cluster_threads_and_files(tmp_path):
+    rng = np.random.default_rng(3)
+    paths = []
+    for i in range(3):
+        path = tmp_path / f"series{i}.npy"
+        np.save(path, rng.standard_normal(20_000 + 1000 * i))
+        paths.append(str(path))
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            x = np.load(paths[0])
+            got = allan_variance_dask(da.from_array(x, chunks=3000), octave(x.size), "mo")
+            np.testing.assert_allclose(got, allan_variance_columns(x, octave(x.size), "mo"), rtol=1e-12)
+            results = allan_variance_files(paths, np.load, octave, "to", scheduler=client, progress=False)
+    for path, (factors, allan) in zip(paths, results):
+        x = np.load(path)
+        np.testing.assert_array_equal(factors, octave(x.size))
+        np.testing.assert_array_equal(allan, allan_variance_columns(x, factors, "to"))
