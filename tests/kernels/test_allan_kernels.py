@@ -78,12 +78,3 @@ def test_many_levels_use_level_wise_path_with_same_values():
     every = averaging_factors(600, taus="all")  # more than FUSED_MAX_LEVELS levels
     assert every.size > _kernels.FUSED_MAX_LEVELS
     np.testing.assert_allclose(allan_variance_columns(x, every, "mo"), numpy_twin(x, every, "mo"), rtol=1e-12)
-
-
-
-def test_column_moments_match_numpy():
-    data = np.random.default_rng(15).standard_normal((200_003, 3)) * [1.0, 1e6, 1e-9] + [0.0, -5.0, 7.0]
-    mean, low, high = _kernels.column_moments(data, block=1000)
-    np.testing.assert_allclose(mean, data.mean(axis=0), rtol=1e-12)
-    np.testing.assert_array_equal(low, data.min(axis=0))
-    np.testing.assert_array_equal(high, data.max(axis=0))

@@ -4,12 +4,16 @@ Nothing here validates input or builds objects: the public functions
 validate once at the boundary and call these kernels on clean arrays. The
 tests check every kernel against a plain NumPy transcription.
 
-* :mod:`avar._kernels.allan`: the empirical Allan variance (compensated
-  cumulative sums, squared second differences per level).
-* :mod:`avar._kernels.streaming`, :mod:`avar._kernels.levels`,
-  :mod:`avar._kernels.columns`: the streaming Allan variance behind the
-  plain-array entry point :func:`allan_variance_columns` (blocks of any real
-  dtype, a small reused workspace instead of O(N) arrays).
+* :mod:`avar._kernels.allan`: compensated cumulative sums held in memory and
+  squared second differences per level (the deviation family's kernels).
+* :mod:`avar._kernels.columns`: the plain-array entry point of the Allan
+  variance, :func:`allan_variance_columns` (any real dtype, read in place in
+  blocks, a small workspace instead of O(N) arrays). It dispatches to
+  :mod:`avar._kernels.small` (short series: one call, one thread),
+  :mod:`avar._kernels.haar` (octave "to": the Haar pyramid, one read),
+  :mod:`avar._kernels.sweep` (octave "mo": a cache-blocked sweep of all
+  levels) or :mod:`avar._kernels.levels` (any other grid, level by level),
+  all on the primitives of :mod:`avar._kernels.streaming`.
 * :mod:`avar._kernels.covariance`: the theoretical Allan variance of a
   covariance matrix (one validating pass, then O(n) per scale).
 * :mod:`avar._kernels.simulation`: recursions of the simulated processes.
@@ -32,7 +36,6 @@ from avar._kernels.allan import (  # noqa: E402
     FUSED_BLOCK,
     FUSED_MAX_LEVELS,
     centred_cumsum,
-    column_moments,
     fused_overlapping_sums,
     squared_difference_sums,
     task_sums,

@@ -55,42 +55,6 @@ FUSED_BLOCK = 1 << 16
 FUSED_MAX_LEVELS = 128
 
 
-@njit(cache=True, parallel=True, nogil=True)
-def column_moments(data, block=CUMSUM_BLOCK):
-    """Mean, minimum and maximum of every column of ``data`` (N, C) in one pass.
-
-    The mean is a sum of block sums (the centre needs no more precision: the
-    Allan variance does not depend on it, and the centring itself is exact).
-    """
-    n, channels = data.shape
-    n_blocks = (n + block - 1) // block
-    sums = np.zeros((channels, n_blocks))
-    lows = np.empty((channels, n_blocks))
-    highs = np.empty((channels, n_blocks))
-    for task in prange(channels * n_blocks):
-        c = task // n_blocks
-        b = task % n_blocks
-        total = 0.0
-        low = data[b * block, c]
-        high = low
-        for i in range(b * block, min(n, (b + 1) * block)):
-            v = data[i, c]
-            total += v
-            low = min(low, v)
-            high = max(high, v)
-        sums[c, b] = total
-        lows[c, b] = low
-        highs[c, b] = high
-    mean = np.empty(channels)
-    low = np.empty(channels)
-    high = np.empty(channels)
-    for c in range(channels):
-        mean[c] = sums[c].sum() / n
-        low[c] = lows[c].min()
-        high[c] = highs[c].max()
-    return mean, low, high
-
-
 @njit(cache=True, inline="always")
 def _two_sum(a, b):
     """Knuth's TwoSum: ``a + b == s + e`` exactly."""

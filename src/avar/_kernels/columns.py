@@ -4,15 +4,22 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from numba import njit
 
-from avar._kernels.levels import level_sums, level_sums_serial
-from avar._kernels.streaming import BLOCK, CHUNK_BLOCKS, LIMIT_EXP, NEAR, block_table, block_table_serial
+from avar._kernels.haar import CHUNK_BLOCKS as HAAR_CHUNK
+from avar._kernels.haar import PYRAMID_EXP, haar_sums
+from avar._kernels.levels import level_sums
+from avar._kernels.small import small_allan_variance
+from avar._kernels.streaming import BLOCK, CHUNK_BLOCKS, LIMIT_EXP, NEAR, block_table
+from avar._kernels.sweep import SWEEP_BLOCK, SWEEP_CHUNK, SWEEP_NEAR, sweep_sums
 
-#: Inputs with at most this many values (N * C) run on one thread: starting
-#: the thread pool costs more than the work.
-SERIAL_MAX = 1 << 17
+#: Series of at most this many samples take the one-call small path
+#: (:mod:`avar._kernels.small`): one thread, a full cumulative sum of 16 bytes
+#: a sample; starting the thread pool would cost more than the work. (Decided
+#: on N alone: a column's bits do not depend on the other columns.)
+SMALL_MAX = 1 << 15
 
 
 @njit(cache=True)
@@ -41,29 +48,55 @@ def _finish(sums, scale, factors, n_diff):
     return out
 
 
-def _run_serial(data, factors, counts, n_diff, is_mo, small_count):
+def _table(data, block):
+    """Block table with the scale of extreme columns: (th, tl, centre, scale)."""
     integral = data.dtype.kind in "iu"
-    ones = np.ones(data.shape[1])
-    # (Python glue on purpose: compiled as one numba function, the level loops
-    # ran ~20x slower; the three dispatches cost a few microseconds.)
-    th, tl, centre, maxabs = block_table_serial(data, ones, integral, BLOCK)
+    th, tl, centre, maxabs = block_table(data, np.ones(data.shape[1]), integral, block)
     scale, redo = _scales(maxabs)
     if redo:
-        th, tl, centre, maxabs = block_table_serial(data, scale, integral, BLOCK)
-    sums = level_sums_serial(data, centre, scale, th, tl, factors, counts, is_mo, small_count, BLOCK, NEAR,
-                             CHUNK_BLOCKS)
-    return _finish(sums, scale, factors, n_diff)
+        th, tl, centre, maxabs = block_table(data, scale, integral, block)
+    return th, tl, centre, scale
 
 
-def _run_parallel(data, factors, counts, n_diff, is_mo, small_count):
-    integral = data.dtype.kind in "iu"
-    ones = np.ones(data.shape[1])
-    th, tl, centre, maxabs = block_table(data, ones, integral, BLOCK)
-    scale, redo = _scales(maxabs)
+def run_levels(data, factors, n_diff, is_mo, block=BLOCK, near=NEAR, chunk=CHUNK_BLOCKS):
+    """Any grid (``factors`` increasing, all valid): level by level (:mod:`avar._kernels.levels`)."""
+    th, tl, centre, scale = _table(data, block)
+    counts = n_diff if is_mo else data.shape[0] // factors
+    small_count = int(np.searchsorted(factors, near, side="right")) if is_mo else factors.shape[0]
+    sums = level_sums(data, centre, scale, th, tl, factors, counts, is_mo, small_count, block, near, chunk)
+    return _finish(sums, scale, factors, n_diff.astype(np.float64))
+
+
+def _chunk(n, block, most):
+    """Blocks per task: ``most``, or fewer so that a short series still makes about 4 tasks.
+
+    A function of N alone: the summation order does not depend on the number of threads.
+    """
+    n_blocks = -(-int(n) // block)
+    return max(1, min(most, -(-n_blocks // 4)))
+
+
+def run_haar(data, factors, n_diff, exp=PYRAMID_EXP, chunk=None):
+    """"to" at power-of-two cluster sizes ``factors`` (increasing): the Haar pyramid."""
+    exps = np.log2(factors).astype(np.int64)
+    n_levels = int(exps[-1]) + 1
+    chunk = _chunk(data.shape[0], 1 << exp, HAAR_CHUNK) if chunk is None else chunk
+    sums, big = haar_sums(data, np.ones(data.shape[1]), n_levels, exp, chunk)
+    scale, redo = _scales(big)
     if redo:
-        th, tl, centre, maxabs = block_table(data, scale, integral, BLOCK)
-    sums = level_sums(data, centre, scale, th, tl, factors, counts, is_mo, small_count, BLOCK, NEAR, CHUNK_BLOCKS)
-    return _finish(sums, scale, factors, n_diff)
+        sums, _ = haar_sums(data, scale, n_levels, exp, chunk)
+    out = _finish(np.ascontiguousarray(sums[:, exps]), scale, factors, n_diff.astype(np.float64))
+    out[~np.isfinite(big)] = np.nan  # a non-finite sample, maybe in no requested level's clusters
+    return out
+
+
+def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=None):
+    """"mo" at power-of-two cluster sizes ``factors`` (increasing): the cache-blocked sweep."""
+    chunk = _chunk(n_diff[0], block, SWEEP_CHUNK) if chunk is None else chunk
+    th, tl, centre, scale = _table(data, block)
+    n_small = int(np.searchsorted(factors, max(near, block)))
+    sums = sweep_sums(data, centre, scale, th, tl, factors, n_diff, n_small, block, chunk)
+    return _finish(sums, scale, factors, n_diff.astype(np.float64))
 
 
 def _as_kernel_input(data) -> np.ndarray:
@@ -95,14 +128,24 @@ def allan_variance_columns(data, factors, type: str) -> np.ndarray:
     n, channels = x.shape
     is_mo = type == "mo"
     n_diff = n - 2 * f + 1 if is_mo else n // np.maximum(f, 1) - 1
+    small = n <= SMALL_MAX
+    if small and f.shape[0] and channels and f.min() >= 1 and n_diff.min() > 0:
+        return small_allan_variance(x, f, n_diff, is_mo, x.dtype.kind in "iu")  # the common short call
     out = np.full((channels, f.shape[0]), np.nan)
     valid = (f >= 1) & (n_diff > 0)
     if not valid.any() or channels == 0:
         return out
-    order = np.argsort(np.where(valid, f, -1), kind="stable")[np.count_nonzero(~valid):]
-    fs = f[order]
-    counts = n_diff[order] if is_mo else n // fs
-    small_count = int(np.searchsorted(fs, NEAR, side="right")) if is_mo else fs.shape[0]
-    run = _run_serial if n * channels <= SERIAL_MAX else _run_parallel
-    out[:, order] = run(x, fs, counts, n_diff[order].astype(np.float64), is_mo, small_count)
+    fs, inverse = np.unique(f[valid], return_inverse=True)  # increasing, distinct
+    nd = n - 2 * fs + 1 if is_mo else n // fs - 1
+    if small:
+        values = small_allan_variance(x, fs, nd, is_mo, x.dtype.kind in "iu")
+    else:
+        # Tasks are handed out one at a time (not in one contiguous range per thread):
+        # a thread slowed down by another process then holds back no other thread.
+        with numba.parallel_chunksize(1):
+            if np.all((fs & (fs - 1)) == 0):  # powers of two (octave grids)
+                values = run_sweep(x, fs, nd) if is_mo else run_haar(x, fs, nd)
+            else:
+                values = run_levels(x, fs, nd, is_mo)
+    out[:, valid] = values[:, inverse.reshape(-1)]
     return out

@@ -178,26 +178,3 @@ def level_sums(data, centre, scale, th, tl, factors, counts, is_mo, small_count,
         for j in range(n_chunks):
             result[c] += out[c, j]
     return result
-
-
-@njit(cache=True)
-def level_sums_serial(data, centre, scale, th, tl, factors, counts, is_mo, small_count, block, near, chunk_blocks):
-    """:func:`level_sums` on one thread, same arithmetic (small inputs)."""
-    channels = data.shape[1]
-    span = counts[0] if is_mo else data.shape[0]
-    n_blocks, n_chunks = _n_chunks(span, block, chunk_blocks)
-    out = np.zeros((channels, n_chunks, factors.shape[0]))
-    for task in range(channels * n_chunks):
-        c = task // n_chunks
-        j = task % n_chunks
-        kb1 = min(n_blocks, (j + 1) * chunk_blocks)
-        if is_mo:
-            mo_task(data, c, j * chunk_blocks, kb1, centre[c], scale[c], th, tl, factors, counts, small_count,
-                    out[c, j], block, near)
-        else:
-            to_task(data, c, j * chunk_blocks, kb1, centre[c], scale[c], th, tl, factors, counts, out[c, j], block)
-    result = np.zeros((channels, factors.shape[0]))
-    for c in range(channels):
-        for j in range(n_chunks):
-            result[c] += out[c, j]
-    return result

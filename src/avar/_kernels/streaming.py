@@ -178,21 +178,6 @@ def block_table(data, scale, integral, block=BLOCK):
 
 
 @njit(cache=True)
-def block_table_serial(data, scale, integral, block=BLOCK):
-    """:func:`block_table` on one thread (small inputs: no thread start-up)."""
-    n, channels = data.shape
-    nb = (n + block - 1) // block
-    bh = np.empty((channels, nb))
-    bl = np.empty((channels, nb))
-    bm = np.empty((channels, nb))
-    for task in range(channels * nb):
-        c = task // nb
-        b = task % nb
-        bh[c, b], bl[c, b], bm[c, b] = _block_sum(data, c, b * block, min(n, (b + 1) * block), scale[c])
-    return _finish_table(bh, bl, bm, n, block, integral)
-
-
-@njit(cache=True)
 def _finish_table(bh, bl, bm, n, block, integral):
     channels, nb = bh.shape
     table_hi = np.empty((channels, nb + 1))

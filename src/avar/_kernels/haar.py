@@ -1,0 +1,194 @@
+"""Tau-overlap Allan variance of power-of-two cluster sizes: the Haar pyramid (numba).
+
+The sums of the clusters of size ``2**(k+1)`` are the sums of consecutive
+pairs of those of size ``2**k``, so every octave level comes from one read
+of the input and N/2 + N/4 + ... additions. The input is read in blocks of
+``2**P`` samples (:data:`PYRAMID_EXP`); inside a block the pyramid lives in
+a small in-cache buffer, and each level carries only its last cluster sum
+from one block to the next. Whole blocks' sums feed the levels above ``P``
+(one value per block, kept in a table of N / 2**P entries).
+
+Exactness: every cluster sum is a double-double ``hi + lo`` (TwoSum of the
+pairs; 64-bit integers enter as two exact halves), so sums are exact to
+O(eps**2) of the cluster magnitude without centring (the differences of
+consecutive clusters do not depend on the centre); the difference of two
+clusters is formed with TwoSum as well. Work is split into tasks of
+``CHUNK_BLOCKS`` blocks whose partial sums, and the differences across task
+boundaries, are added in a fixed order: the bits do not depend on the number
+of threads.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange, types
+from numba.extending import overload
+
+from avar._kernels.streaming import _fast_sum, _two_sum
+
+#: log2 of the samples per block.
+PYRAMID_EXP = 12
+
+#: Blocks per parallel task (fixes the summation order).
+CHUNK_BLOCKS = 64
+
+
+def _pair(x, sc):  # pragma: no cover - replaced by the overload in compiled code
+    raise NotImplementedError
+
+
+@overload(_pair, inline="always")
+def _pair_overload(x, sc):
+    """``x * sc`` as an exact pair ``(hi, lo)`` (64-bit integers split in two halves)."""
+    if isinstance(x, types.Integer) and x.bitwidth == 64:
+        shift = np.uint64(32) if not x.signed else np.int64(32)
+        mask = np.uint64(0xFFFFFFFF) if not x.signed else np.int64(0xFFFFFFFF)
+
+        def impl(x, sc):
+            return _two_sum(np.float64(x >> shift) * 4294967296.0, np.float64(x & mask))
+
+        return impl
+
+    def impl(x, sc):
+        return np.float64(x) * sc, 0.0
+
+    return impl
+
+
+@njit(cache=True, inline="always")
+def _dd_add(ah, al, bh, bl):
+    s, e = _two_sum(ah, bh)
+    return s, e + (al + bl)
+
+
+@njit(cache=True, inline="always")
+def _dd_diff(ah, al, bh, bl):
+    """``(ah + al) - (bh + bl)`` rounded once to float64 (compensated)."""
+    s, e = _two_sum(ah, -bh)
+    return s + (e + (al - bl))
+
+
+@njit(cache=True)
+def _block(data, col, start, count, sc, h, l, buffer, levels, first_h, first_l, last_h, last_l, have, sums):
+    """Pyramid of one block of ``count`` samples; updates the carried state of levels 0..P.
+
+    Returns the largest magnitude of the block (to detect extreme scales; nan
+    if a sample is not finite).
+    """
+    x = data[start : start + count, col]
+    big = 0.0
+    probe = 0.0  # nan if a sample is not finite
+    # level 0: the samples themselves (differences of consecutive samples)
+    for i in range(count):
+        a, b = _pair(x[i], sc)
+        h[i] = a
+        l[i] = b
+        big = max(big, abs(a))
+        probe += 0.0 * a
+    width = count
+    for k in range(levels):
+        if width == 0:
+            break
+        for j in range(width - 1):
+            buffer[j] = _dd_diff(h[j + 1], l[j + 1], h[j], l[j])
+            buffer[j] *= buffer[j]
+        total = _fast_sum(buffer, width - 1)
+        if have[k]:
+            d = _dd_diff(h[0], l[0], last_h[k], last_l[k])
+            total += d * d
+        else:
+            first_h[k] = h[0]
+            first_l[k] = l[0]
+            have[k] = True
+        sums[k] += total
+        last_h[k] = h[width - 1]
+        last_l[k] = l[width - 1]
+        half = width // 2
+        for j in range(half):
+            h[j], l[j] = _dd_add(h[2 * j], l[2 * j], h[2 * j + 1], l[2 * j + 1])
+        width = half
+    return big + probe
+
+
+@njit(cache=True)
+def _task(data, col, kb0, kb1, sc, levels, block, sums, first_h, first_l, last_h, last_l, have, bh, bl):
+    n = data.shape[0]
+    h = np.empty(block)
+    l = np.empty(block)
+    buffer = np.empty(block)
+    big = 0.0
+    finite = True
+    for kb in range(kb0, kb1):
+        start = kb * block
+        count = min(block, n - start)
+        r = _block(data, col, start, count, sc, h, l, buffer, levels, first_h, first_l, last_h, last_l, have, sums)
+        finite = finite and np.isfinite(r)
+        big = max(big, r)
+        if count == block:  # a whole block: its sum feeds the upper levels
+            bh[kb] = h[0]
+            bl[kb] = l[0]
+    return big if finite else np.nan
+
+
+@njit(cache=True, parallel=True)
+def _tasks_parallel(data, sc, levels, block, chunk, n_tasks, n_blocks, sums, fh, fl, lh, ll, have, bh, bl, big):
+    channels = data.shape[1]
+    for task in prange(channels * n_tasks):
+        c = task // n_tasks
+        j = task % n_tasks
+        big[c, j] = _task(data, c, j * chunk, min(n_blocks, (j + 1) * chunk), sc[c], levels, block,
+                          sums[c, j], fh[c, j], fl[c, j], lh[c, j], ll[c, j], have[c, j], bh[c], bl[c])
+
+
+@njit(cache=True)
+def _combine(sums, fh, fl, lh, ll, have, bh, bl, n_full, levels, n_levels):
+    """Per-column sums of D**2 of levels 0 .. n_levels - 1, shape (C, n_levels)."""
+    channels, n_tasks, _ = sums.shape
+    out = np.zeros((channels, n_levels))
+    for c in range(channels):
+        for k in range(levels):
+            total = 0.0
+            for j in range(n_tasks):
+                total += sums[c, j, k]
+                if j > 0 and have[c, j, k] and have[c, j - 1, k]:
+                    d = _dd_diff(fh[c, j, k], fl[c, j, k], lh[c, j - 1, k], ll[c, j - 1, k])
+                    total += d * d
+            out[c, k] = total
+        # upper levels: a pyramid over the whole blocks' sums
+        h = bh[c, :n_full].copy()
+        l = bl[c, :n_full].copy()
+        width = n_full
+        for k in range(levels, n_levels):
+            half = width // 2
+            for j in range(half):
+                h[j], l[j] = _dd_add(h[2 * j], l[2 * j], h[2 * j + 1], l[2 * j + 1])
+            width = half
+            total = 0.0
+            for j in range(width - 1):
+                d = _dd_diff(h[j + 1], l[j + 1], h[j], l[j])
+                total += d * d
+            out[c, k] = total
+    return out
+
+
+def haar_sums(data, scale, n_levels, exp=PYRAMID_EXP, chunk=CHUNK_BLOCKS):
+    """Sums of squared differences of consecutive cluster sums at m = 2**k, k < ``n_levels``.
+
+    Returns ``(sums, big)``: shape (C, n_levels), and the largest magnitude of
+    ``data * scale`` per column (to rescale extreme data and run again; nan
+    when a sample is not finite).
+    """
+    n, channels = data.shape
+    block = 1 << exp
+    levels = min(exp + 1, n_levels)
+    n_blocks = -(-n // block)
+    n_tasks = max(1, -(-n_blocks // chunk))
+    shape = (channels, n_tasks, levels)
+    sums = np.zeros(shape)
+    fh, fl, lh, ll = np.zeros(shape), np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    have = np.zeros(shape, dtype=np.bool_)
+    bh, bl = np.zeros((channels, n_blocks)), np.zeros((channels, n_blocks))
+    big = np.zeros((channels, n_tasks))
+    _tasks_parallel(data, scale, levels, block, chunk, n_tasks, n_blocks, sums, fh, fl, lh, ll, have, bh, bl, big)
+    out = _combine(sums, fh, fl, lh, ll, have, bh, bl, n // block, levels, n_levels)
+    return out, big.max(axis=1)

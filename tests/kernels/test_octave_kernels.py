@@ -1,0 +1,165 @@
+"""The octave kernels (Haar pyramid "to", cache-blocked sweep "mo") and the small path.
+
+Each is run with tiny blocks and tasks so that a few thousand samples cross
+every boundary (blocks, window slides, regions, tasks, upper pyramid
+levels), and checked against exact rational arithmetic and a plain loop.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numba
+import numpy as np
+import pytest
+from reference import allan_mo_loop, allan_to_loop
+
+from avar._kernels import columns
+from avar._kernels.small import small_allan_variance
+
+
+def exact(values, factors, type: str) -> list[float]:
+    """AV in exact rationals over the exact values (Python ints, or float64 as Fractions)."""
+    ints = [int(v) if isinstance(v, (int, np.integer)) else Fraction(float(v)) for v in values]
+    s = [Fraction(0)]
+    for v in ints:
+        s.append(s[-1] + v)
+    n = len(ints)
+    out = []
+    for m in map(int, factors):
+        starts = range(n - 2 * m + 1) if type == "mo" else range(0, (n // m - 1) * m, m)
+        total = sum((s[b + 2 * m] - 2 * s[b + m] + s[b]) ** 2 for b in starts)
+        out.append(float(total / (2 * m * m * len(starts))))
+    return out
+
+
+def loop_reference(x, m, type):
+    return allan_mo_loop(x, m) if type == "mo" else allan_to_loop(x, m)
+
+
+def octave(n, first=1):
+    return 2 ** np.arange(first, n.bit_length() - 1, dtype=np.int64)
+
+
+def adversarial(n):
+    rng = np.random.default_rng(99)
+    t = np.arange(n)
+    step = np.where(t < n // 3, 1e6, -1e6) + 1e-3 * rng.standard_normal(n)
+    return {
+        "offset": 1e6 + 1e-3 * rng.standard_normal(n),
+        "drift": 1e-3 * t + 1e-6 * rng.standard_normal(n),
+        "random walk": np.cumsum(rng.standard_normal(n)),
+        "step": step,
+    }
+
+
+def n_diff(n, factors, type):
+    return n - 2 * factors + 1 if type == "mo" else n // factors - 1
+
+
+def run(x, factors, type, **tiny):
+    data = np.asarray(x)[:, None] if np.ndim(x) == 1 else x
+    nd = n_diff(data.shape[0], factors, type)
+    if type == "mo":
+        return columns.run_sweep(data, factors, nd, **tiny)
+    return columns.run_haar(data, factors, nd, **tiny)
+
+
+TINY = {"mo": dict(block=64, near=256, chunk=3), "to": dict(exp=5, chunk=3)}
+
+
+@pytest.mark.parametrize("name", ["offset", "drift", "random walk", "step"])
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_octave_kernels_exact_on_adversarial_inputs(name, type):
+    n = 3000
+    x = adversarial(n)[name]
+    factors = octave(n, first=0)
+    got = run(x, factors, type, **TINY[type])[0]
+    np.testing.assert_allclose(got, exact(x, factors, type), rtol=1e-10, atol=0)
+
+
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_octave_kernels_on_grids_with_gaps_and_one_level(type):
+    n = 3001
+    x = adversarial(n)["random walk"]
+    for factors in (np.array([1, 4, 64, 256, 1024]), np.array([128]), np.array([2, 1024])):
+        got = run(x, factors.astype(np.int64), type, **TINY[type])[0]
+        np.testing.assert_allclose(got, [loop_reference(x, m, type) for m in factors], rtol=1e-11)
+
+
+@pytest.mark.parametrize(
+    "dtype", [np.float32, np.int8, np.int32, np.int64, np.uint16, np.uint64]
+)
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_octave_kernels_read_every_dtype_exactly(dtype, type):
+    rng = np.random.default_rng(3)
+    n = 1100
+    if np.dtype(dtype).kind == "f":
+        x = (rng.standard_normal(n) * 100).astype(dtype)
+    else:
+        info = np.iinfo(dtype)
+        x = rng.integers(info.min, info.max, size=n, dtype=dtype, endpoint=True)
+    factors = octave(n, first=0)
+    got = run(x, factors, type, **TINY[type])[0]
+    np.testing.assert_allclose(got, exact(x.tolist(), factors, type), rtol=1e-12)
+
+
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_octave_kernels_extreme_magnitudes_are_rescaled(type):
+    x = adversarial(2000)["random walk"]
+    factors = octave(2000)
+    want = run(x, factors, type, **TINY[type])
+    for scale in (2.0**450, 2.0**-450):  # beyond 2**+-400: the kernels rescale by a power of two
+        np.testing.assert_allclose(run(x * scale, factors, type, **TINY[type]) / scale / scale, want, rtol=1e-13)
+
+
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_default_parameters_match_the_level_by_level_path(type, tmp_path):
+    # Above the small path: default blocks and tasks, two columns, a memmap.
+    rng = np.random.default_rng(8)
+    x = np.cumsum(rng.standard_normal((300_001, 2)), axis=0) + 1e4
+    factors = octave(300_001)
+    nd = n_diff(300_001, factors, type)
+    want = columns.run_levels(x, factors, nd, type == "mo")
+    got = columns.allan_variance_columns(x, factors, type)
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    path = tmp_path / "x.npy"
+    np.save(path, x)
+    np.testing.assert_array_equal(columns.allan_variance_columns(np.load(path, mmap_mode="r"), factors, type), got)
+    single = columns.allan_variance_columns(np.ascontiguousarray(x[:, 1]), factors, type)
+    np.testing.assert_array_equal(single[0], got[1])
+
+
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_octave_kernels_bits_do_not_depend_on_thread_count(type):
+    x = np.cumsum(np.random.default_rng(7).standard_normal((40_000, 2)), axis=0)
+    factors = octave(40_000)
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = run(x, factors, type, **TINY[type])
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = run(x, factors, type, **TINY[type])
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(one, two)
+
+
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_small_path_matches_loop_on_every_scale(type):
+    x = adversarial(301)["step"]
+    factors = np.arange(1, 151, dtype=np.int64)
+    got = small_allan_variance(x[:, None], factors, n_diff(301, factors, type), type == "mo", False)[0]
+    np.testing.assert_allclose(got, exact(x, factors, type), rtol=1e-10)
+
+
+@pytest.mark.parametrize("type", ["mo", "to"])
+def test_long_series_non_finite_values_are_found_by_the_kernel_pass(type):
+    import avar
+
+    n = 2**20 + 5  # beyond the up-front check: the kernels' pass finds the value
+    for position in (0, n - 1):
+        x = np.zeros(n, dtype=np.float32)
+        x[position] = np.inf
+        with pytest.raises(ValueError, match=rf"1 non-finite value\(s\) \(0 NaN, 1 inf\); the first is at index {position}"):
+            avar.avar(x, type=type)
