@@ -453,3 +453,29 @@ def test_plot_imu_avlr_per_axis_fit_and_validation(navchip, navchip_fit, fit):
 def test_plot_compare_is_exported_lazily(res):
     fig = avar.plot_compare({"run": res})
     assert [ln.get_label() for ln in fig.axes[0].lines] == ["run"]
+
+
+# --------------------------------------------------------------------------- chi-squared band
+def test_plot_draws_the_chi2_band_at_every_level():
+    res = avar.avar(np.random.default_rng(11).standard_normal(N), freq=100.0, ci="chi2")
+    r_band = avar.avar(np.random.default_rng(11).standard_normal(N), freq=100.0)
+    assert (res.lci > 0).all() and r_band.lci[-1] < 0
+    every = np.ones(len(res), dtype=bool)
+    ax = res.plot(deviation=True).axes[0]
+    assert band_points(ax) == expected_band(res.levels, res.lci, res.uci, every)
+    assert band_points(ax) != expected_band(r_band.levels, r_band.lci, r_band.uci, r_band.lci > 0)
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["Empirical AD", "chi2 CI(AD, 0.683)"]
+    ax = res.plot().axes[0]
+    assert band_points(ax) == expected_band(res.levels, res.lci**2, res.uci**2, every)
+    low, high = ax.get_ylim()
+    assert low <= (res.lci**2).min() and high >= (res.uci**2).max()
+    render(ax.figure)
+
+
+def test_plot_imu_draws_each_channels_chi2_band():
+    data = np.random.default_rng(3).standard_normal((4096, 2))
+    res = avar.avar(IMU(data, freq=10, gyro=[0], accel=[1], name="demo"), ci="chi2", confidence=0.95)
+    fig = res.plot(deviation=True)
+    for ax, av in zip(fig.axes, res.channels.values()):
+        assert band_points(ax) == expected_band(av.levels, av.lci, av.uci, np.ones(len(av), dtype=bool))
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == ["Empirical AD", "chi2 CI(AD, 0.95)"]

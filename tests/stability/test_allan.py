@@ -255,3 +255,98 @@ def test_decreasing_time_index_is_named():
 
 def test_numpy_integer_length():
     assert averaging_factors(np.int64(100)).tolist() == [2, 4, 8, 16, 32]
+
+
+# --------------------------------------------------------------------------- ci="chi2"
+@pytest.mark.parametrize("type, estimator", [("mo", "oadev"), ("to", "adev")])
+def test_chi2_band_is_chi2_bounds_of_the_edf(type, estimator):
+    from avar.stability.edf import chi2_bounds, estimator_edf
+    from avar.stability.noise_id import identify_noise
+
+    x = np.random.default_rng(5).standard_normal(4096) * 0.3 + 2.0
+    res = avar.avar(x, type=type, freq=50.0, ci="chi2")
+    phase = np.concatenate(([0.0], np.cumsum(x - x.mean()))) / 50.0
+    alpha = identify_noise(phase, res.averaging_factors, estimator)
+    edf = estimator_edf(estimator, alpha, res.averaging_factors, 4097)
+    lci, uci = chi2_bounds(res.adev, edf, 0.683)
+    assert res.ci == "chi2" and res.confidence == 0.683
+    np.testing.assert_array_equal(res.alpha, alpha)
+    np.testing.assert_array_equal(res.edf, edf)
+    np.testing.assert_array_equal(res.lci, lci)
+    np.testing.assert_array_equal(res.uci, uci)
+    assert (res.alpha[:6] == 0).all()  # white FM (white noise series)
+    # the same Allan variance and R errors as ci="r"
+    r_band = avar.avar(x, type=type, freq=50.0)
+    np.testing.assert_array_equal(res.allan, r_band.allan)
+    np.testing.assert_array_equal(res.errors, r_band.errors)
+    # positive at every level, also the largest (m = N / 2) where R's band goes negative
+    assert r_band.lci[-1] < 0
+    assert (res.lci > 0).all() and (res.lci <= res.adev).all() and (res.adev <= res.uci).all()
+    # few terms at m = N / 2: a wide band (edf ~ 1)
+    assert res.uci[-1] / res.adev[-1] > 1.5
+
+
+def test_chi2_band_values_white_fm_non_overlapping():
+    # "to" at m = 1024 of N = 4096: 3 differences of independent means, white FM with F = infinity:
+    # edf = 2 M**2 / (3 M - 1) = 18 / 8 exactly
+    from scipy.stats import chi2
+
+    from avar.stability.edf import estimator_edf
+
+    x = np.random.default_rng(2).standard_normal(4096)
+    res = avar.avar(x, type="to", taus=[1024.0], ci="chi2")
+    assert estimator_edf("adev", [0], [1024], 4097)[0] == pytest.approx(18 / 8, rel=1e-12)
+    assert res.edf[0] == estimator_edf("adev", res.alpha, [1024], 4097)[0]
+
+    q = (1 - 0.683) / 2
+    assert res.lci[0] == pytest.approx(res.adev[0] * np.sqrt(res.edf[0] / chi2.isf(q, res.edf[0])), rel=1e-14)
+
+
+def test_chi2_confidence_and_default_r_band_unchanged():
+    x = np.random.default_rng(8).standard_normal(2000)
+    narrow = avar.avar(x, ci="chi2")
+    wide = avar.avar(x, ci="chi2", confidence=0.95)
+    assert wide.confidence == 0.95
+    assert (wide.lci < narrow.lci).all() and (wide.uci > narrow.uci).all()
+    default = avar.avar(x)
+    assert default.ci == "r" and default.alpha is None and default.edf is None and default.confidence is None
+    np.testing.assert_array_equal(default.lci, default.adev * (1 - 2 * default.errors))
+    np.testing.assert_array_equal(default.uci, default.adev * (1 + 2 * default.errors))
+    assert list(default.summary().columns) == ["Time", "AVar", "ADev", "Lower CI", "Upper CI"]
+    table = narrow.summary()
+    assert list(table.columns) == ["Time", "AVar", "ADev", "Lower CI", "Upper CI", "Alpha", "EDF"]
+    np.testing.assert_array_equal(table["Lower CI"], narrow.lci)
+    np.testing.assert_array_equal(table["EDF"], narrow.edf)
+    assert "chi-squared 0.683 band" in narrow.describe()
+    with pytest.raises(ValueError):
+        narrow.edf[0] = 1.0
+
+
+def test_chi2_band_of_imu_channels():
+    from avar.imu import IMU
+
+    rng = np.random.default_rng(4)
+    data = np.column_stack([rng.standard_normal(3000), np.cumsum(rng.standard_normal(3000))])
+    res = avar.avar(IMU(data, freq=10, gyro=[0], accel=[1], name="imu"), ci="chi2", confidence=0.9)
+    for j, channel in enumerate(res.channels.values()):
+        alone = avar.avar(data[:, j], freq=10.0, ci="chi2", confidence=0.9)
+        np.testing.assert_array_equal(channel.lci, alone.lci)
+        np.testing.assert_array_equal(channel.alpha, alone.alpha)
+        assert channel.ci == "chi2" and (channel.lci > 0).all()
+    gyro, accel = res.channels.values()
+    assert gyro.alpha[0] == 0 and accel.alpha[0] == -2  # white FM, random-walk FM
+    assert list(res.summary().columns)[-2:] == ["Alpha", "EDF"]
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"ci": "normal"}, "ci must be 'r'"),
+        ({"ci": "chi2", "confidence": 1.5}, r"confidence must be a number in \(0, 1\)"),
+        ({"ci": "chi2", "confidence": True}, r"confidence must be a number in \(0, 1\)"),
+        ({"confidence": 0.9}, "confidence applies to ci='chi2' only"),
+    ],
+)
+def test_ci_validation(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        avar.avar(np.arange(100.0), **kwargs)

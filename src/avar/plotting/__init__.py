@@ -8,13 +8,15 @@ methods, :func:`avar.plot_compare` and the command line.
 * :mod:`avar.plotting.compare`: several Allan variances on one axes;
 * :mod:`avar.plotting.report`: the noise-report figure (``NoiseReport.plot()``).
 * :mod:`avar.plotting.gmwm`: GMWM fits (:func:`plot_gmwm`, :func:`plot_imu_gmwm`).
+* :mod:`avar.plotting.deviation`: the deviation family (:func:`plot_deviation`, ``Deviation.plot()``).
 """
 
 from avar.plotting.compare import plot_compare
+from avar.plotting.deviation import plot_deviation
 from avar.plotting.gmwm import plot_gmwm, plot_imu_gmwm
 from avar.plotting.imu import plot_imu_avar, plot_imu_avlr
 from avar.plotting.report import plot_report
 from avar.plotting.single import plot_avar, plot_avlr
 
-__all__ = ["plot_avar", "plot_avlr", "plot_compare", "plot_gmwm", "plot_imu_avar", "plot_imu_avlr", "plot_imu_gmwm",
+__all__ = ["plot_avar", "plot_avlr", "plot_compare", "plot_deviation", "plot_gmwm", "plot_imu_avar", "plot_imu_avlr", "plot_imu_gmwm",
            "plot_report"]

@@ -133,6 +133,17 @@ def band(av: AllanVariance, deviation: bool) -> tuple[np.ndarray, np.ndarray, np
     return lower, upper, valid
 
 
+def band_label(av: AllanVariance, name: str) -> str:
+    """Legend label of the band a result carries: R's (about 95%) or the chi-squared one.
+
+    >>> import numpy as np, avar
+    >>> x = np.random.default_rng(0).standard_normal(256)
+    >>> band_label(avar.avar(x), "AD"), band_label(avar.avar(x, ci="chi2"), "AV")
+    ('CI(AD, 0.95)', 'chi2 CI(AV, 0.683)')
+    """
+    return f"chi2 CI({name}, {av.confidence:g})" if av.ci == "chi2" else f"CI({name}, 0.95)"
+
+
 def axis_labels(units: str | None, deviation: bool, xlab: str | None, ylab: str | None) -> tuple[str, str]:
     """Default x and y labels: averaging time (in ``units``) and AV or AD."""
     if xlab is None:

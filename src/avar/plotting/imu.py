@@ -18,6 +18,7 @@ from avar.plotting.base import (
     AD_COLOUR,
     CI_COLOUR,
     IMPLIED_COLOUR,
+    band_label,
     check_flag,
     check_style,
     draw_empirical,
@@ -108,7 +109,7 @@ def draw_grid(
             setup_log_axes(ax)
             drawn += draw_empirical(ax, av, deviation=deviation, colour=col_ad, band_colour=col_ci, ci=ci,
                                     marker=marker, markersize=markersize, label=f"Empirical {name}",
-                                    band_label=f"CI({name}, 0.95)")
+                                    band_label=band_label(av, name))
             if implied is not None and channel in implied:
                 drawn.append(draw_fit(ax, av, implied[channel], (decomposition or {}).get(channel),
                                       (scales or {}).get(kind), deviation=deviation, colour=col_implied,

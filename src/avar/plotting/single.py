@@ -15,10 +15,11 @@ show a plot in a GUI window, create the axes with pyplot and pass them::
 Plots are log-log. The empirical Allan variance (AV, default) or Allan
 deviation (AD, ``deviation=True``) is drawn as points joined by a line, over
 the shaded band between the lower and upper confidence bounds ``lci`` and
-``uci`` of the Allan deviation (squared for the AV). A level whose lower
-bound is not positive (e.g. the level m = N / 2, where the relative error is
-1 / sqrt(2)) stays on the line but has no band, since a log axis cannot show
-it.
+``uci`` of the Allan deviation (squared for the AV): R's band, or the
+chi-squared band of a ``ci="chi2"`` result, as the legend says. A level whose
+lower bound is not positive (e.g. the level m = N / 2 of R's band, where the
+relative error is 1 / sqrt(2)) stays on the line but has no band, since a log
+axis cannot show it.
 
 Functions: :func:`plot_avar` (``AllanVariance.plot``), :func:`plot_avlr`
 (``AvlrResult.plot``), :func:`plot_compare` (several curves on one axes),
@@ -40,6 +41,7 @@ from avar.plotting.base import (
     IMPLIED_COLOUR,
     axis_labels,
     band,
+    band_label,
     check_colour,
     check_flag,
     check_legend_position,
@@ -79,7 +81,9 @@ def plot_avar(
     AD(tau) = sqrt(AV) with ``deviation=True``, which is what R draws) is
     plotted as points and line against tau = m / freq. The band spans the
     bounds of the AD, ``lci``/``uci`` = AD (1 -/+ 2 errors) (about 95%), or
-    their squares for the AV; levels with ``lci <= 0`` have no band.
+    their squares for the AV; levels with ``lci <= 0`` have no band. A result
+    of ``avar.avar(..., ci="chi2")`` carries the chi-squared band instead
+    (positive at every level); the legend names the band drawn.
 
     Parameters
     ----------
@@ -136,7 +140,7 @@ def plot_avar(
     name = quantity(deviation)
     drawn = draw_empirical(ax, x, deviation=deviation, colour=col_ad, band_colour=col_ci, ci=ci,
                            marker=marker, markersize=markersize, label=f"Empirical {name}",
-                           band_label=f"CI({name}, 0.95)")
+                           band_label=band_label(x, name))
     xlab, ylab = axis_labels(units, deviation, xlab, ylab)
     finish(ax, xlab, ylab, DEFAULT_TITLE if main is None else main, legend, log_limits(*drawn))
     return fig

@@ -4,7 +4,9 @@
 * :mod:`avar.stability.columns`: the Allan variance of every column of a table
   (the one estimation path of series and IMU channels);
 * :mod:`avar.stability.allan`: :func:`avar` (R-compatible "mo"/"to");
-* :mod:`avar.stability.intervals`: confidence intervals;
+* :mod:`avar.stability.intervals`: confidence intervals (R's, chi-squared);
+* :mod:`avar.stability.edf`: Greenhall's EDF, chi-squared bounds;
+* :mod:`avar.stability.noise_id`: power-law noise identification;
 * :mod:`avar.stability.results`: :class:`AllanVariance`, :class:`ImuAllanVariance`.
 """
 

@@ -15,11 +15,12 @@ from avar._validation import SHIFT_LIMIT, as_float64, as_series, shift_huge
 from avar.imu import IMU
 from avar.stability.columns import allan_variance_columns
 from avar.stability.grids import averaging_factors, check_type, n_differences
-from avar.stability.intervals import relative_errors
+from avar.stability.intervals import check_ci, chi2_band, relative_errors
 from avar.stability.results import AllanVariance, ImuAllanVariance
 
 
-def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octave"):
+def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octave", ci: str = "r",
+         confidence: float | None = None, nan_policy: str = "raise"):
     """Empirical Allan variance of a series (or of every channel of an IMU).
 
     With x_1..x_N the series, m the cluster size, tau = m / freq and
@@ -52,6 +53,23 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
     taus : {"octave", "decade", "all"} or array_like of float
         Tau grid; see :func:`averaging_factors`. ``"octave"`` (m = 2, 4, ...,
         2**(floor(log2 N) - 1)) reproduces the R package.
+    ci : {"r", "chi2"}
+        Confidence band of the Allan deviation, the result's ``lci``/``uci``.
+        ``"r"`` (default): R's adev (1 -/+ 2 errors), errors = 1 / sqrt(2 (N / m
+        - 1)), about 95% for many terms, negative where m > N / 3.
+        ``"chi2"``: the chi-squared band adev sqrt(edf / chi2(edf)) (NIST SP
+        1065 eq. 45), positive at every level; the noise alpha is identified
+        per level (lag-1 autocorrelation, :mod:`avar.stability.noise_id`) on the
+        phase x = (0, cumsum(x)) / freq, and the EDF is Greenhall's for OADEV
+        (type "mo") or ADEV (type "to") (:mod:`avar.stability.edf`). The
+        result then also carries ``alpha``, ``edf`` and ``confidence``.
+    confidence : float, optional
+        Confidence level of the ``"chi2"`` band, in (0, 1); default 0.683 (Stable32).
+    nan_policy : {"raise", "omit"}
+        NaN in a series: an error (default), or gaps whose differences are
+        skipped: every difference of cluster means that touches a NaN is left
+        out and ``n_differences`` counts those used ("mo" is then OADEV**2 of
+        ``x`` as frequency data, "to" ADEV**2; see :mod:`avar.stability.gaps`).
 
     Returns
     -------
@@ -85,8 +103,20 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
     True
     >>> avar.avar([892, 809, 823, 798, 671, 644, 883, 903, 677], taus=[1, 2]).adev
     array([91.22945..., 85.95287...])
+    >>> band = avar.avar(x, freq=100.0, ci="chi2")
+    >>> band.alpha[:3], band.edf[:2].round(1)
+    (array([0, 0, 0]), array([5416.9, 3074.8]))
+    >>> bool(np.all((band.lci > 0) & (band.lci <= band.adev) & (band.adev <= band.uci)))
+    True
     """
     kind = check_type(type)
+    band = check_ci(ci, confidence)
+    if nan_policy != "raise":  # checked, and gaps computed, by the deviation family's kernels: loaded on demand
+        from avar.stability.gaps import allan_variance_with_gaps, check_nan_policy, series_with_gaps
+
+        gappy = series_with_gaps(x, freq) if check_nan_policy(nan_policy) and not isinstance(x, IMU) else None
+        if gappy is not None:
+            return allan_variance_with_gaps(*gappy, kind, taus, band)
     if isinstance(x, IMU):
         if freq is not None:
             raise ValueError("an IMU carries its own freq; do not pass freq with an IMU")
@@ -97,9 +127,9 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
             channels = {}
             for j, channel in enumerate(x.channels):
                 column = shift_huge(as_float64(np.ascontiguousarray(data[:, j])))
-                channels.update(allan_variance_table(column[:, None], (channel,), x.freq, kind, taus))
+                channels.update(allan_variance_table(column[:, None], (channel,), x.freq, kind, taus, band))
         else:
-            channels = allan_variance_table(x.data, x.channels, x.freq, kind, taus)
+            channels = allan_variance_table(x.data, x.channels, x.freq, kind, taus, band)
         return ImuAllanVariance(
             sensor=x.name,
             freq=x.freq,
@@ -109,18 +139,19 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
             axes=x.axes,
             units=x.units,
         )
-    values, rate = as_series(x, freq)
-    return allan_variance_table(values[:, None], (None,), rate, kind, taus)[None]
+    values, rate = as_series(x, freq, native=True)
+    return allan_variance_table(values[:, None], (None,), rate, kind, taus, band)[None]
 
 
 def allan_variance_table(
-    data: np.ndarray, names: tuple, freq: float, type: str, taus: Any
+    data: np.ndarray, names: tuple, freq: float, type: str, taus: Any, band: tuple = ("r", None)
 ) -> dict[Any, AllanVariance]:
     """Allan variance of every column of a validated (N, C) table, keyed by column name.
 
     The one estimation path: a series is a table of one column, an IMU a table
     of its channels, and every column shares the tau grid and one pass of the
-    kernels; each column's result equals that of the column alone.
+    kernels; each column's result equals that of the column alone. ``band``
+    is (ci, confidence): with "chi2" each column also gets its chi-squared band.
     """
     n = data.shape[0]
     factors = averaging_factors(n, freq, taus)
@@ -128,17 +159,13 @@ def allan_variance_table(
     levels = factors / freq
     errors = relative_errors(n, factors)
     counts = n_differences(n, factors, type)
-    return {
-        name: AllanVariance(
-            levels=levels,
-            averaging_factors=factors,
-            allan=allan[j],
-            errors=errors,
-            n_differences=counts,
-            type=type,
-            freq=freq,
-            n=n,
-            name=name,
-        )
-        for j, name in enumerate(names)
-    }
+    ci, confidence = band
+    results = {}
+    for j, name in enumerate(names):
+        extra: dict[str, Any] = {}
+        if ci == "chi2":
+            alpha, edf, lci, uci = chi2_band(data[:, j], factors, freq, type, allan[j], confidence)
+            extra = dict(ci=ci, confidence=confidence, alpha=alpha, edf=edf, chi2_lci=lci, chi2_uci=uci)
+        results[name] = AllanVariance(levels=levels, averaging_factors=factors, allan=allan[j], errors=errors,
+                                      n_differences=counts, type=type, freq=freq, n=n, name=name, **extra)
+    return results

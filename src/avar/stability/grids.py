@@ -70,10 +70,23 @@ def averaging_factors(n: int, freq: float = 1.0, taus: Any = "octave") -> np.nda
     """
     n = int(n)
     largest = max_averaging_factor(n)
+    return grid_factors(taus, freq, largest, first_octave=1,
+                        context=f"(averaging factors 1..{largest} at freq = {freq:g} Hz, N = {n})")
+
+
+def grid_factors(taus: Any, rate: float, largest: int, first_octave: int, context: str) -> np.ndarray:
+    """Averaging factors 1 <= m <= ``largest`` of a named grid or of explicit taus (s) at ``rate`` Hz.
+
+    The one grid builder of every estimator: ``"octave"`` is m = 2**first_octave,
+    ..., the largest power of two <= ``largest``; ``"decade"`` 1, 2, 4 x 10**k;
+    ``"all"`` 1..largest; an array of taus is rounded to whole m, sorted and
+    deduplicated, and a tau outside the range raises ``ValueError`` naming it,
+    the valid range in seconds and ``context`` (the estimator, N, rate).
+    """
     if isinstance(taus, str):
         grid = taus.lower()
         if grid == "octave":
-            return 2 ** np.arange(1, n.bit_length() - 1, dtype=np.int64)
+            return 2 ** np.arange(first_octave, largest.bit_length(), dtype=np.int64)
         if grid == "decade":
             decades = 10 ** np.arange(0, len(str(largest)), dtype=np.int64)
             factors = np.sort(np.outer(decades, [1, 2, 4]).ravel())
@@ -81,18 +94,23 @@ def averaging_factors(n: int, freq: float = 1.0, taus: Any = "octave") -> np.nda
         if grid == "all":
             return np.arange(1, largest + 1, dtype=np.int64)
         raise ValueError(f"unknown tau grid {taus!r}; use one of {NAMED_GRIDS} or an array of taus in seconds")
-    requested = np.atleast_1d(np.asarray(taus))
+    try:
+        requested = np.atleast_1d(np.asarray(taus))
+    except ValueError:  # ragged
+        requested = np.empty((0, 0))
     if requested.dtype.kind not in "iuf" or requested.ndim != 1 or requested.size == 0:
-        raise TypeError("taus must be 'octave', 'decade', 'all' or a non-empty 1-D array of averaging times (s)")
+        raise TypeError(
+            f"taus must be 'octave', 'decade', 'all' or a non-empty 1-D array of averaging times (s), "
+            f"got {short_repr(taus)}"
+        )
     requested = requested.astype(np.float64)
     if not np.all(np.isfinite(requested)):
-        raise ValueError("taus must be finite averaging times in seconds")
-    factors = np.round(requested * freq)
-    low, high = 1.0 / freq, largest / freq
+        raise ValueError(f"taus must be finite averaging times in seconds, got {short_repr(requested.tolist())}")
+    factors = np.round(requested * rate)
     outside = (factors < 1) | (factors > largest)
     if outside.any():
         raise ValueError(
             f"taus {short_repr(requested[outside].tolist())} are outside the valid range "
-            f"[{low:g}, {high:g}] s (averaging factors 1..{largest} at freq = {freq:g} Hz, N = {n})"
+            f"[{1 / rate:g}, {largest / rate:g}] s {context}"
         )
     return np.unique(factors.astype(np.int64))

@@ -10,10 +10,12 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:  # pandas loads with the first table
+    import pandas as pd
 
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
@@ -54,11 +56,23 @@ class AllanVariance:
         Length of the series.
     name : str or None
         Optional label (the channel name for IMU data).
+    ci : {"r", "chi2"}
+        Which confidence band ``lci``/``uci`` are: the R package's, or the
+        chi-squared band of Greenhall's EDF (``avar.avar(..., ci="chi2")``).
+    confidence : float or None
+        Confidence level of the chi-squared band (None for ``ci="r"``).
+    alpha : ndarray of int64 or None
+        Identified power-law noise exponent per level (``ci="chi2"``).
+    edf : ndarray or None
+        Equivalent degrees of freedom per level (``ci="chi2"``).
+    chi2_lci, chi2_uci : ndarray or None
+        The chi-squared bounds of the Allan deviation (``ci="chi2"``).
 
     Notes
     -----
-    ``adev``, ``lci`` and ``uci`` derive from ``allan`` and ``errors`` as in
-    the R package: adev = sqrt(allan), lci/uci = adev (1 -/+ 2 errors).
+    ``adev`` = sqrt(allan). With ``ci="r"``, ``lci`` and ``uci`` derive from
+    ``allan`` and ``errors`` as in the R package: adev (1 -/+ 2 errors); with
+    ``ci="chi2"`` they are ``chi2_lci`` and ``chi2_uci``, positive at every level.
     """
 
     levels: np.ndarray
@@ -70,6 +84,12 @@ class AllanVariance:
     freq: float
     n: int
     name: str | None = None
+    ci: str = "r"
+    confidence: float | None = None
+    alpha: np.ndarray | None = None
+    edf: np.ndarray | None = None
+    chi2_lci: np.ndarray | None = None
+    chi2_uci: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         set_field = object.__setattr__
@@ -85,12 +105,33 @@ class AllanVariance:
                              f"got {short_repr(self.type)}")
         for name in ("allan", "errors"):
             values = getattr(self, name)
-            bad = np.flatnonzero(~(values >= 0) | ~np.isfinite(values))
-            if bad.size:
+            if values.size and not (values.min() >= 0 and values.max() < np.inf):  # a nan makes min() nan
+                bad = np.flatnonzero(~(values >= 0) | ~np.isfinite(values))
                 raise ValueError(f"{name} must hold finite values >= 0 (a variance and its relative error), "
                                  f"got {values[bad[0]]!r} at level {bad[0]}")
         set_field(self, "freq", check_freq(self.freq))
         set_field(self, "n", int(self.n))
+        self._check_band()
+
+    def _check_band(self) -> None:
+        """The chi-squared fields: all given, one per level, positive, with ci="chi2"; else none."""
+        names = ("alpha", "edf", "chi2_lci", "chi2_uci")
+        if self.ci == "r":
+            if self.confidence is not None or any(getattr(self, name) is not None for name in names):
+                raise ValueError("confidence, alpha, edf, chi2_lci and chi2_uci belong to ci='chi2' results")
+            return
+        if self.ci != "chi2":
+            raise ValueError(f"ci must be 'r' (R's band) or 'chi2' (chi-squared band), got {short_repr(self.ci)}")
+        if not isinstance(self.confidence, (float, int)) or not 0 < self.confidence < 1:
+            raise ValueError(f"confidence must be in (0, 1) for ci='chi2', got {short_repr(self.confidence)}")
+        for name in names:
+            if getattr(self, name) is None:
+                raise ValueError(f"a ci='chi2' result needs {name}")
+            object.__setattr__(self, name, frozen_array(getattr(self, name), np.int64 if name == "alpha" else np.float64))
+            if len(getattr(self, name)) != len(self.levels):
+                raise ValueError(f"{name} must have one value per level")
+        if not (np.all(self.edf > 0) and np.all(self.chi2_lci >= 0) and np.all(self.chi2_uci >= self.chi2_lci)):
+            raise ValueError("edf must be > 0 and 0 <= chi2_lci <= chi2_uci at every level")
 
     @property
     def adev(self) -> np.ndarray:
@@ -99,13 +140,13 @@ class AllanVariance:
 
     @property
     def lci(self) -> np.ndarray:
-        """Lower confidence bound of the Allan deviation, adev (1 - 2 errors)."""
-        return self.adev * (1.0 - 2.0 * self.errors)
+        """Lower confidence bound of the Allan deviation: adev (1 - 2 errors), or ``chi2_lci``."""
+        return self.chi2_lci if self.ci == "chi2" else self.adev * (1.0 - 2.0 * self.errors)
 
     @property
     def uci(self) -> np.ndarray:
-        """Upper confidence bound of the Allan deviation, adev (1 + 2 errors)."""
-        return self.adev * (1.0 + 2.0 * self.errors)
+        """Upper confidence bound of the Allan deviation: adev (1 + 2 errors), or ``chi2_uci``."""
+        return self.chi2_uci if self.ci == "chi2" else self.adev * (1.0 + 2.0 * self.errors)
 
     def __len__(self) -> int:
         return len(self.levels)
@@ -117,19 +158,17 @@ class AllanVariance:
         the index ``Scale`` numbers the levels from 1, as the scale selections
         of :func:`avar.avlr` do. The CI columns bound the Allan *deviation*
         (R's adev (1 -/+ 2 errors)); the lower one is negative where
-        errors > 1/2, i.e. at scales m > N/3.
+        errors > 1/2, i.e. at scales m > N/3. A ``ci="chi2"`` result has the
+        chi-squared bounds there instead, and two more columns: ``Alpha``
+        (identified noise) and ``EDF``.
         """
-        return pd.DataFrame(
-            {
-                "Time": self.levels,
-                "AVar": self.allan,
-                "ADev": self.adev,
-                "Lower CI": self.lci,
-                "Upper CI": self.uci,
-            },
-            columns=SUMMARY_COLUMNS,
-            index=pd.RangeIndex(1, len(self) + 1, name="Scale"),
-        )
+        import pandas as pd
+
+        columns = {"Time": self.levels, "AVar": self.allan, "ADev": self.adev,
+                   "Lower CI": self.lci, "Upper CI": self.uci}
+        if self.ci == "chi2":
+            columns.update({"Alpha": self.alpha, "EDF": self.edf})
+        return pd.DataFrame(columns, columns=list(columns), index=pd.RangeIndex(1, len(self) + 1, name="Scale"))
 
     def describe(self) -> str:
         """One line: estimator, length, rate and number of levels."""
@@ -137,9 +176,12 @@ class AllanVariance:
         return (
             f"{label}Allan variance ({TYPE_NAMES.get(self.type, self.type)}, type {self.type!r}), "
             f"N = {self.n}, freq = {format_frequency(self.freq)}, {len(self)} levels"
+            + (f", chi-squared {self.confidence:g} band" if self.ci == "chi2" else "")
         )
 
     def __str__(self) -> str:
+        import pandas as pd
+
         table = pd.DataFrame(
             {"Time": self.levels, "m": self.averaging_factors, "AVar": self.allan, "ADev": self.adev}
         )
@@ -224,6 +266,8 @@ class ImuAllanVariance:
 
     def summary(self) -> pd.DataFrame:
         """All channels' summary tables stacked, indexed by (channel, 1-based scale)."""
+        import pandas as pd
+
         frames = {name: av.summary() for name, av in self.channels.items()}
         return pd.concat(frames, names=["Channel", "Scale"])
 

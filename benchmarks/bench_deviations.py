@@ -1,0 +1,140 @@
+"""Time the deviation family against allantools on the same data and taus, same run.
+
+Usage::
+
+    python benchmarks/bench_deviations.py            # N = 1e5, 1e6, 1e7 (totdev up to 1e6)
+    python benchmarks/bench_deviations.py --quick    # N = 1e5, 1e6, one repeat
+
+Frequency data (white FM), ``taus="octave"`` on both sides (allantools is given
+our averaging times, so both compute the same levels). Columns:
+
+* ``allantools``: the plain call (deviations only);
+* ``allantools full``: the allantools recipe for everything our public
+  function returns: the deviation, then per tau ``autocorr_noise_id`` (Barnes's
+  B1 and R(n), ``allantools.ci.b1``/``rn`` and their boundaries, where fewer
+  than 30 points remain and ``autocorr_noise_id`` raises), ``edf_greenhall``
+  (``edf_totdev`` for totdev) and ``confidence_interval`` (at our 0.683);
+* ``core``: :func:`avar.stability.deviation_core.deviation_levels` alone
+  (variances and term counts: what the plain allantools call computes);
+* ``avar``: the public function (validation, variances, noise
+  identification, EDF and chi-squared bounds).
+
+Times are the median of a few runs after a warm-up (numba compilation);
+ratios are peer time / our time: ``core`` and ``avar`` against the plain
+call, ``full`` = allantools full / avar. The acceptance point checked at the
+end: the public function at least 3x faster than the plain allantools call at
+N = 1e6, for every estimator.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import time
+import warnings
+
+import numpy as np
+
+import avar
+from avar.stability.deviation_core import deviation_levels
+from avar.stability.deviation_grids import ESTIMATORS, deviation_factors
+
+try:
+    import allantools
+    from allantools import ci as atci
+except ImportError:  # pragma: no cover - the "bench" extra
+    allantools = atci = None
+
+#: Greenhall's (d, overlapping, modified) of each estimator, as allantools.ci.confidence_interval_noiseID.
+GREENHALL = {"adev": (2, False, False), "oadev": (2, True, False), "mdev": (2, True, True),
+             "tdev": (2, True, True), "hdev": (3, False, False), "ohdev": (3, True, False)}
+TARGET = 3.0
+ACCEPTANCE_N = 10**6
+
+
+def median_time(function, repeat: int) -> float:
+    function()
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return float(np.median(times))
+
+
+def allantools_alpha(x: np.ndarray, m: int, rate: float, dmax: int) -> int:
+    """allantools' noise ID at one tau: lag-1 autocorrelation, B1 and R(n) below 30 points."""
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):  # it prints before raising
+            return int(atci.autocorr_noise_id(x, m, data_type="phase", dmin=0, dmax=dmax)[0])
+    except NotImplementedError:
+        k = (len(x) - 1) // m
+        if k < 3:
+            return 0
+        b1 = atci.b1(x, m, rate)
+        for b_hi, alpha in ((-3, -2), (-2, -1), (-1, 0)):
+            if b1 > atci.b1_boundary(b_hi, k):
+                return alpha
+        return 1 if atci.rn(x, m, rate) > atci.rn_boundary(m, 0) else 2
+
+
+def allantools_full(estimator: str, y: np.ndarray, taus: np.ndarray, rate: float = 1.0):
+    """The deviation and its chi-squared bounds per tau, the allantools way."""
+    out_taus, devs, _, _ = getattr(allantools, estimator)(y, rate=rate, data_type="freq", taus=taus)
+    x = allantools.frequency2phase(y, rate)
+    dmax = 3 if estimator in ("hdev", "ohdev") else 2
+    bounds = []
+    for tau, dev in zip(out_taus, devs):
+        m = int(round(tau * rate))
+        alpha = allantools_alpha(x, m, rate, dmax)
+        if estimator == "totdev":
+            edf = atci.edf_totdev(len(x), m, alpha)
+        else:
+            d, overlapping, modified = GREENHALL[estimator]
+            edf = atci.edf_greenhall(alpha=alpha, d=d, m=m, N=len(x), overlapping=overlapping, modified=modified)
+        bounds.append(atci.confidence_interval(dev, edf, ci=0.683) if edf else (np.nan, np.nan))
+    return devs, bounds
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="N = 1e5 and 1e6, one repeat")
+    args = parser.parse_args()
+    warnings.simplefilter("ignore")  # allantools' polyfit RankWarning on long series
+    sizes = [10**5, 10**6] if args.quick else [10**5, 10**6, 10**7]
+    repeat = 1 if args.quick else 3
+    print("| estimator | N | levels | allantools (ms) | allantools full (ms) | avar core (ms) | avar (ms) "
+          "| core vs allantools | avar vs allantools | avar vs allantools full |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    public_ratio = {}
+    for n in sizes:
+        y = np.random.default_rng(0).standard_normal(n) * 1e-11
+        for estimator in ESTIMATORS:
+            if estimator == "totdev" and n > 10**6:
+                continue
+            factors = deviation_factors(estimator, n + 1, 1.0, "octave")
+            ours = median_time(lambda: getattr(avar, estimator)(y), repeat)
+            core = median_time(lambda: deviation_levels(estimator, y, factors, "freq"), repeat)
+            if allantools is None:
+                print(f"| {estimator} | {n:.0e} | {factors.size} | - | - | {core * 1e3:.1f} | {ours * 1e3:.1f} "
+                      "| - | - | - |", flush=True)
+                continue
+            taus = factors.astype(float)
+            peer_repeat = 1 if n >= 10**7 else repeat
+            peer = median_time(lambda: getattr(allantools, estimator)(y, rate=1.0, data_type="freq", taus=taus),
+                               peer_repeat)
+            full = median_time(lambda: allantools_full(estimator, y, taus), peer_repeat)
+            if n == ACCEPTANCE_N:
+                public_ratio[estimator] = peer / ours
+            print(f"| {estimator} | {n:.0e} | {factors.size} | {peer * 1e3:.1f} | {full * 1e3:.1f} "
+                  f"| {core * 1e3:.1f} | {ours * 1e3:.1f} | {peer / core:.1f}x | {peer / ours:.1f}x "
+                  f"| {full / ours:.1f}x |", flush=True)
+    if public_ratio:
+        print(f"\nAcceptance (public function >= {TARGET:g}x the plain allantools call at N = {ACCEPTANCE_N:.0e}):")
+        for estimator, ratio in public_ratio.items():
+            print(f"  {estimator:7s} {ratio:5.1f}x  {'holds' if ratio >= TARGET else 'NOT MET'}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,142 @@
+"""The detrended phase of the deviation family as a double-double (numba).
+
+See :mod:`avar._kernels.deviations` for how the kernels use it: the phase is
+rebuilt from its increments (the fractional frequency, or the first
+differences of phase data, each an exact pair by Knuth's TwoSum) minus a line
+``centre + slope i`` (removed exactly: ``slope i`` is exact by construction),
+by a compensated running sum ``hi + lo``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from avar._kernels.allan import CUMSUM_BLOCK
+
+
+@njit(cache=True, inline="always")
+def _two_sum(a, b):
+    s = a + b
+    bv = s - a
+    e = (a - (s - bv)) + (b - bv)
+    return s, e
+
+
+@njit(cache=True)
+def _scan_block(data, start, stop):
+    count = 0
+    total = 0.0
+    low = np.inf
+    high = -np.inf
+    for i in range(start, stop):
+        v = data[i]
+        if np.isnan(v):
+            count += 1
+        else:
+            total += v
+            low = min(low, v)
+            high = max(high, v)
+    return count, total, low, high
+
+
+@njit(cache=True, parallel=True, nogil=True)
+def scan(data, block=CUMSUM_BLOCK):
+    """Number of NaN, and sum, minimum and maximum of the other values, in one parallel pass."""
+    n = data.shape[0]
+    n_blocks = (n + block - 1) // block
+    nans = np.zeros(n_blocks, dtype=np.int64)
+    sums = np.zeros(n_blocks)
+    lows = np.full(n_blocks, np.inf)
+    highs = np.full(n_blocks, -np.inf)
+    for b in prange(n_blocks):
+        nans[b], sums[b], lows[b], highs[b] = _scan_block(data, b * block, min(n, (b + 1) * block))
+    count = 0
+    total = 0.0
+    low = np.inf
+    high = -np.inf
+    for b in range(n_blocks):  # in order: the result does not depend on the thread count
+        count += nans[b]
+        total += sums[b]
+        low = min(low, lows[b])
+        high = max(high, highs[b])
+    return count, total, low, high
+
+
+@njit(cache=True, inline="always")
+def _increment(data, data_lo, i, kind, centre, slope, scale):
+    """Increment ``i`` minus ``centre + slope i``, times ``scale``, as an exact pair."""
+    if kind == 1:
+        h, l = _two_sum(data[i + 1], -data[i])
+    elif kind == 2:
+        h = data[i]
+        l = np.float64(data_lo[i])
+    else:
+        h = data[i]
+        l = 0.0
+    if slope != 0.0:
+        h, e1 = _two_sum(h, -(slope * i))
+        l += e1
+    h, e2 = _two_sum(h, -centre)
+    return h * scale, (l + e2) * scale
+
+
+@njit(cache=True, parallel=True, nogil=True)
+def detrended_phase(data, data_lo, kind, centre, slope, scale, hi, lo, block=CUMSUM_BLOCK):
+    """Fill ``hi`` (float64), ``lo`` (float32; length M + 1) with the compensated running sum of the increments.
+
+    ``kind`` 0: ``data`` is the frequency (M values, the increments
+    themselves); 1: the phase (M + 1 values, increments ``data[i + 1] -
+    data[i]``); 2: the increments are the pairs ``data[i] + data_lo[i]`` (the
+    running sum of the phase, for MDEV). ``data_lo`` is unused (any float32
+    array) for kinds 0 and 1. Increment ``i``
+    enters as ``(increment - centre - slope i) scale``; ``slope i`` must be
+    exact and ``scale`` a power of two. ``hi[0] = lo[0] = 0``. Two parallel
+    passes over blocks with an exact scan of the block sums between them: the
+    block size, not the thread count, fixes the arithmetic.
+    """
+    n = hi.shape[0] - 1
+    n_blocks = (n + block - 1) // block
+    block_hi = np.zeros(n_blocks)
+    block_lo = np.zeros(n_blocks)
+    for b in prange(n_blocks):
+        total = 0.0
+        comp = 0.0
+        for i in range(b * block, min(n, (b + 1) * block)):
+            h, l = _increment(data, data_lo, i, kind, centre, slope, scale)
+            total, err = _two_sum(total, h)
+            comp += err + l
+        block_hi[b] = total
+        block_lo[b] = comp
+    total = 0.0
+    comp = 0.0
+    for b in range(n_blocks):
+        offset_hi = block_hi[b]
+        offset_lo = block_lo[b]
+        block_hi[b] = total
+        block_lo[b] = comp
+        total, err = _two_sum(total, offset_hi)
+        comp += err + offset_lo
+    hi[0] = 0.0
+    lo[0] = 0.0
+    for b in prange(n_blocks):
+        total = block_hi[b]
+        comp = block_lo[b]
+        for i in range(b * block, min(n, (b + 1) * block)):
+            h, l = _increment(data, data_lo, i, kind, centre, slope, scale)
+            total, err = _two_sum(total, h)
+            comp += err + l
+            hi[i + 1] = total
+            lo[i + 1] = comp
+
+
+@njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
+def centred_moment(data, kind):
+    """sum_i (i - (M - 1) / 2) increment_i over the M increments (``kind`` 0: ``data`` itself; 1: its differences)."""
+    count = data.shape[0] - kind
+    half = (count - 1) / 2.0
+    total = 0.0
+    for i in range(count):
+        v = data[i + 1] - data[i] if kind == 1 else data[i]
+        total += (i - half) * v
+    return total

@@ -1,0 +1,170 @@
+"""Lag-1 autocorrelation noise identification (numba).
+
+Per averaging factor m: decimate the phase to x[0], x[m], x[2m], ..., remove a
+least-squares quadratic, then difference until the lag-1 autocorrelation says
+the series is stationary enough. Two streaming passes over the K = N / m
+decimated points and no workspace: the first sums the quadratic's
+projections, the second forms the residuals and their differences on the fly and
+accumulates, for two orders of difference at a time, the sum, the sum of squares and the lag-1 sum of products. The plain
+twin is :func:`avar.stability.noise_id.lag1_alpha` (NumPy), which the tests
+compare.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+#: Sums may be reassociated (vectorized): the statistic is a ratio compared with 0.25 and rounded.
+_FAST = {"reassoc", "contract"}
+
+
+@njit(cache=True, nogil=True)
+def lag1_alpha_decimated(x, m, dmax):
+    """alpha of x[0], x[m], x[2m], ... by the lag-1 autocorrelation (Riley and Greenhall 2004).
+
+    The decimated series z (K points) loses its least-squares quadratic,
+    computed with the discrete orthogonal polynomials 1, t, t**2 - (K**2 - 1) / 12
+    of the centred index t (three sums, no linear system). Then, with
+    r1 = sum (z_i - zbar)(z_{i+1} - zbar) / sum (z_i - zbar)**2 and
+    rho = r1 / (1 + r1), z is differenced until rho < 0.25 or d = dmax, and
+    alpha = 2 - round(2 rho) - 2 d (round half to even, as ``numpy.round``).
+    Returns NaN for a constant series. Needs K >= 3 and dmax <= 3.
+    """
+    k = (x.shape[0] - 1) // m + 1
+    half = (k - 1) / 2.0
+    c2 = (k * k - 1.0) / 12.0
+    s0, s1, s2 = _projections(x, m, k, half, c2)
+    kf = float(k)
+    a0 = s0 / kf
+    a1 = s1 / (kf * (kf * kf - 1.0) / 12.0)
+    a2 = s2 / (kf * (kf * kf - 1.0) * (kf * kf - 4.0) / 180.0) if k > 2 else 0.0
+    stats = np.zeros((4, 5))  # per order d: sum, sum of squares, lag-1 products, first, last value
+    for d in range(dmax + 1):
+        if d % 2 == 0:  # orders d and d + 1 in one pass (most series stop at d = 0 or 1)
+            _order_pass(x, m, k, half, c2, a0, a1, a2, d, stats)
+        length = k - d
+        total, squares, products, first, last = stats[d, 0], stats[d, 1], stats[d, 2], stats[d, 3], stats[d, 4]
+        mean = total / length
+        power = squares - total * mean
+        if not power > 0.0:
+            return np.nan
+        lag = products - mean * (2.0 * total - first - last) + (length - 1) * mean * mean
+        r1 = lag / power
+        rho = r1 / (1.0 + r1)
+        if rho < 0.25 or d >= dmax:
+            return 2.0 - np.round(2.0 * rho) - 2.0 * d
+    return np.nan
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def _projections(x, m, k, half, c2):
+    """Sums of x[i m] times 1, t and t**2 - c2 (t = i - half)."""
+    s0 = 0.0
+    s1 = 0.0
+    s2 = 0.0
+    for i in range(k):
+        v = x[i * m]
+        t = i - half
+        s0 += v
+        s1 += t * v
+        s2 += (t * t - c2) * v
+    return s0, s1, s2
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
+    """Stats of the differences of orders ``low`` and ``low + 1`` (0 or 2) of the residuals, streamed."""
+    ta = tb = qa = qb = pa = pb = 0.0
+    w0 = w1 = w2 = w3 = 0.0  # the latest value of every order
+    fa = fb = 0.0
+    for i in range(k):
+        t = i - half
+        v0 = x[i * m] - (a0 + a1 * t + a2 * (t * t - c2))
+        v1 = v0 - w0
+        v2 = v1 - w1
+        v3 = v2 - w2
+        if low == 0:
+            va, vb, ua, ub = v0, v1, w0, w1
+        else:
+            va, vb, ua, ub = v2, v3, w2, w3
+        pa += ua * va
+        pb += ub * vb
+        ta += va
+        tb += vb
+        qa += va * va
+        qb += vb * vb
+        w0, w1, w2, w3 = v0, v1, v2, v3
+        if i <= low + 1:  # order d starts at point d: drop what came before
+            if i < low:
+                ta = qa = pa = 0.0
+            elif i == low:
+                fa = va
+                pa = 0.0
+            if i <= low:
+                tb = qb = pb = 0.0
+            else:
+                fb = vb
+                pb = 0.0
+    stats[low, 0], stats[low, 1], stats[low, 2], stats[low, 3], stats[low, 4] = ta, qa, pa, fa, w0 if low == 0 else w2
+    stats[low + 1, 0], stats[low + 1, 1], stats[low + 1, 2] = tb, qb, pb
+    stats[low + 1, 3], stats[low + 1, 4] = fb, w1 if low == 0 else w3
+
+
+@njit(cache=True, nogil=True)
+def lag1_levels(x, factors, dmax, out):
+    """:func:`lag1_alpha_decimated` at every factor into ``out``, serially."""
+    for i in range(factors.shape[0]):
+        out[i] = lag1_alpha_decimated(x, factors[i], dmax)
+
+
+@njit(cache=True, parallel=True, nogil=True)
+def lag1_levels_split(x, factors, dmax, out):
+    """:func:`lag1_levels` on two threads: the first level (the longest; at the octave
+    m = 1 it holds half the points) on one, the others on the other."""
+    for worker in prange(2):
+        if worker == 0:
+            out[0] = lag1_alpha_decimated(x, factors[0], dmax)
+        else:
+            _decimating_levels(x, factors, dmax, out)
+
+
+@njit(cache=True, nogil=True)
+def _decimating_levels(x, factors, dmax, out):
+    """Levels 1, 2, ... of :func:`lag1_levels_split`: where a factor is a multiple of the one
+    before (octaves), the decimated points are taken from that level's contiguous copy
+    (decimated in place) rather than from ``x`` at a long stride: the same values, fewer
+    cache lines read."""
+    n = x.shape[0]
+    buffer = np.empty((n - 1) // factors[1] + 1) if factors.shape[0] > 1 else np.empty(1)
+    held = 0  # the factor whose points ``buffer`` holds (0: none)
+    length = 0
+    for i in range(1, factors.shape[0]):
+        m = factors[i]
+        if held > 0 and m % held == 0:
+            step = m // held
+            length = (length - 1) // step + 1
+            for j in range(length):
+                buffer[j] = buffer[j * step]
+        else:
+            length = (n - 1) // m + 1
+            if length > buffer.shape[0]:
+                buffer = np.empty(length)
+            for j in range(length):
+                buffer[j] = x[j * m]
+        held = m
+        out[i] = lag1_alpha_decimated(buffer[:length], 1, dmax)
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def running_sum(x, drift, step, out):
+    """R(n)'s running sum of the phase ``x_i + drift i (i - 1) / 2`` at every ``step``-th index:
+    ``out[q] = sum_{i < q step}`` for q = 0 .. len(out) - 1 (block sums, then their running sum)."""
+    total = 0.0
+    out[0] = 0.0
+    for q in range(out.shape[0] - 1):
+        block = 0.0
+        for i in range(q * step, (q + 1) * step):
+            block += x[i] + drift * (i * (i - 1.0) / 2.0)
+        total += block
+        out[q + 1] = total

@@ -1,0 +1,353 @@
+"""The time-and-frequency deviation family: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV, TOTDEV.
+
+Named and defined as in NIST SP 1065 (Riley 2008), Stable32 and
+``allantools``. Every function validates its input once, computes the
+variances in O(N) per level (:mod:`avar.stability.deviation_core`, kernels in
+:mod:`avar._kernels.deviations`), identifies the noise per level
+(:func:`avar.stability.noise_id.identify_noise`) and bounds the deviation by
+chi-squared with Greenhall's EDF (:mod:`avar.stability.edf`).
+
+Conventions shared by all (x_i the phase in s, N phase points, tau0 = 1 /
+rate, m the averaging factor, tau = m tau0):
+
+* ``data_type="phase"``: the data are x_i. ``"freq"``: the data are the
+  fractional frequency y_i, converted to phase as x = (0, cumsum(y)) tau0,
+  as ``allantools.frequency2phase`` does (N = len(y) + 1).
+* The levels are those with at least one term (NIST, Stable32);
+  ``allantools`` drops the levels with a single term.
+* Gaps: NaN values raise (``nan_policy="raise"``) or are skipped
+  (``"omit"``): every term that touches a NaN (phase data: uses a missing
+  point; frequency data: spans a missing value) is left out and ``n`` counts
+  the terms used, as ``allantools.gradev`` does for ADEV. A level left with
+  no term is dropped. The noise is then identified on the longest gap-free
+  stretch, and the EDF is scaled by the fraction of the terms used (at least 1).
+"""
+
+from __future__ import annotations
+
+import numbers
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from avar._kernels.deviation_phase import scan
+from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, short_repr
+from avar.stability.deviation_core import deviation_levels_and_phase
+from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors, term_counts
+from avar.stability.deviation_results import Deviation
+from avar.stability.edf import chi2_bounds, estimator_edf
+from avar.stability.noise_id import NOISE_ID_ESTIMATORS, identify_noise, phase_noise
+
+DATA_TYPES = ("freq", "phase")
+NAN_POLICIES = ("raise", "omit")
+DEFAULT_CONFIDENCE = 0.683
+
+_PARAMETERS = """
+    Parameters
+    ----------
+    data : array_like or pandas.Series
+        1-D real data: fractional frequency y (``data_type="freq"``) or phase
+        (time error) x in seconds (``data_type="phase"``). NaN marks a gap
+        (see ``nan_policy``); infinite values are refused.
+    rate : float
+        Sampling rate in Hz; tau0 = 1 / rate.
+    data_type : {"freq", "phase"}
+        What ``data`` holds (default ``"freq"``; ``allantools`` defaults to ``"phase"``).
+    taus : {"octave", "decade", "all"} or array_like of float
+        Averaging times: m = 1, 2, 4, ...; 1, 2, 4 x 10**k; every m; or
+        explicit taus in seconds (rounded to whole m; one outside the valid
+        range raises ``ValueError`` naming it).
+    confidence : float
+        Two-sided confidence level of ``lci``/``uci`` in (0, 1); 0.683 (1 sigma) as Stable32.
+    nan_policy : {"raise", "omit"}
+        ``"raise"``: NaN raises ``ValueError`` naming its index; ``"omit"``:
+        terms touching a NaN are skipped and ``n`` counts the terms used.
+
+    Returns
+    -------
+    Deviation
+        ``taus``, ``deviation``, ``variance``, ``n``, ``alpha``, ``edf``,
+        ``lci``, ``uci``, ``summary()``, ``plot()``.
+"""
+
+
+def _check_data(data: Any, data_type: str, nan_policy: str) -> tuple[np.ndarray, tuple]:
+    """Float64 values of ``data`` and their :func:`scan` (NaN count, sum, min, max), or an error naming ``data``."""
+    if isinstance(data, pd.DataFrame):
+        raise TypeError("data is a DataFrame; give one column (a 1-D series) of phase or frequency data")
+    if isinstance(data, pd.Series):
+        data = data.to_numpy()
+    if isinstance(data, (str, bytes)):
+        raise TypeError("data must be a numeric 1-D array of phase or frequency data, got a string")
+    array = as_array(data, "data")
+    check_numeric_dtype(array, "data")
+    if array.ndim != 1:
+        raise ValueError(f"data must be 1-D, got an array of shape {array.shape}")
+    values = np.ascontiguousarray(as_float64(array), dtype=np.float64)
+    if not values.flags.writeable:  # one compiled signature of the kernels
+        values = values.copy()
+    scanned = scan(values) if values.size else (0, 0.0, np.inf, -np.inf)  # one pass: NaN, sum, min, max
+    if np.isinf(scanned[2]) and scanned[0] < values.size or np.isinf(scanned[3]) and scanned[0] < values.size:
+        infinite = np.flatnonzero(np.isinf(values))
+        raise ValueError(f"data has {infinite.size} infinite value(s), the first at index {infinite[0]}; "
+                         "infinite values are never accepted (NaN marks a gap, see nan_policy)")
+    n_missing = int(scanned[0])
+    if n_missing and nan_policy == "raise":
+        missing = np.flatnonzero(np.isnan(values))
+        raise ValueError(f"data has {n_missing} NaN value(s), the first at index {missing[0]}; pass "
+                         "nan_policy='omit' to skip the terms that touch them, or remove/fill them")
+    if n_missing == values.size:
+        raise ValueError("data holds only NaN values")
+    return values, scanned
+
+
+def _check_options(estimator: str, rate: Any, data_type: Any, confidence: Any, nan_policy: Any) -> float:
+    if not isinstance(data_type, str) or data_type not in DATA_TYPES:
+        raise ValueError(f"data_type must be 'freq' (fractional frequency) or 'phase' (time error, s), "
+                         f"got {short_repr(data_type)}")
+    if not isinstance(nan_policy, str) or nan_policy not in NAN_POLICIES:
+        raise ValueError(f"nan_policy must be 'raise' or 'omit', got {short_repr(nan_policy)}")
+    if isinstance(confidence, (bool, np.bool_)) or not isinstance(confidence, numbers.Real):
+        raise TypeError(f"confidence must be a number in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
+    if not 0.0 < float(confidence) < 1.0:
+        raise ValueError(f"confidence must be in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
+    return check_freq(rate, "rate")
+
+
+def _longest_stretch(values: np.ndarray) -> np.ndarray:
+    """The longest run of finite values."""
+    finite = np.concatenate(([False], np.isfinite(values), [False]))
+    edges = np.flatnonzero(np.diff(finite.astype(np.int8)))
+    starts, stops = edges[::2], edges[1::2]
+    longest = int(np.argmax(stops - starts))
+    return values[starts[longest] : stops[longest]]
+
+
+def noise_exponents(estimator: str, values: np.ndarray, data_type: str, rate: float, factors: np.ndarray) -> np.ndarray:
+    """Noise exponent per level from gap-free phase (the longest stretch when there are gaps)."""
+    stretch = _longest_stretch(values) if np.isnan(values).any() else values
+    if data_type == "freq":
+        stretch = np.concatenate(([0.0], np.cumsum(stretch - stretch.mean()))) / rate
+    alpha = np.zeros(factors.size, dtype=np.int64)
+    fits = factors < stretch.size
+    if stretch.size >= 4 and fits.any():
+        alpha[fits] = identify_noise(stretch, factors[fits], estimator)
+        alpha[~fits] = alpha[fits][-1]
+    return alpha
+
+
+def _shared_phase_noise(estimator: str, phase: np.ndarray, drift: float, factors: np.ndarray) -> np.ndarray:
+    """:func:`noise_exponents` of gap-free data from the detrended phase of the variances."""
+    alpha = np.zeros(factors.size, dtype=np.int64)
+    fits = factors < phase.size
+    if phase.size >= 4 and fits.any():
+        alpha[fits] = phase_noise(phase, factors[fits], NOISE_ID_ESTIMATORS[estimator], drift, line_free=True)
+        alpha[~fits] = alpha[fits][-1]
+    return alpha
+
+
+def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, confidence: Any,
+              nan_policy: Any) -> Deviation:
+    """Validate once, compute the variances, identify the noise and bound the deviation."""
+    rate = _check_options(estimator, rate, data_type, confidence, nan_policy)
+    values, scanned = _check_data(data, data_type, nan_policy)
+    n_missing = int(scanned[0])
+    n_phase = values.size + (data_type == "freq")
+    needed = MIN_PHASE_POINTS[estimator] - (data_type == "freq")
+    if values.size < needed:
+        raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
+    factors = deviation_factors(estimator, n_phase, rate, taus)
+    variance, n, phase, drift = deviation_levels_and_phase(estimator, values, factors, data_type, rate, scanned)
+    if n_missing:
+        keep = n > 0
+        if not keep.any():
+            raise ValueError(f"no {estimator} term avoids the {n_missing} NaN value(s) of data at these taus")
+        factors, variance, n = factors[keep], variance[keep], n[keep]
+    if not np.all(np.isfinite(variance)):
+        raise ValueError(f"{estimator} overflows float64; rescale the data, e.g. to other units")
+    deviation = np.sqrt(variance)
+    if n_missing:
+        alpha = noise_exponents(estimator, values, data_type, rate, factors)
+    else:  # the variances' own detrended phase: no second pass over the data
+        alpha = _shared_phase_noise(estimator, phase, drift, factors)
+    edf = estimator_edf(estimator, alpha, factors, n_phase)
+    if n_missing:
+        # fewer terms, fewer degrees of freedom; but never below one (a single Gaussian term)
+        edf = np.maximum(edf * n / term_counts(estimator, n_phase, factors), 1.0)
+    lci, uci = chi2_bounds(deviation, edf, float(confidence))
+    return Deviation(
+        taus=factors / rate, averaging_factors=factors, deviation=deviation, variance=variance, n=n,
+        alpha=alpha, edf=edf, lci=lci, uci=uci, estimator=estimator, data_type=data_type, rate=rate,
+        n_samples=values.size, confidence=float(confidence),
+    )
+
+
+def adev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+    """Allan deviation (non-overlapping), NIST SP 1065 eq. (7)::
+
+        sigma_y^2(tau) = sum_{k} (x_{(k+2)m} - 2 x_{(k+1)m} + x_{km})^2 / (2 tau^2 n),
+
+    with n = floor((N - 1) / m) - 1 terms (k = 0 .. n - 1) and m = 1 .. (N - 1) / 2.
+    Dimensionless.
+    {parameters}
+    References
+    ----------
+    W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.adev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0])  # fractional frequency
+    >>> res.averaging_factors.tolist(), res.n.tolist()
+    ([1, 2], [6, 2])
+    >>> res.deviation.round(6).tolist()  # sqrt((4 + 1 + 4 + 1 + 4 + 1) / (2 * 6)), ...
+    [1.118034, 0.707107]
+    """
+    return _estimate("adev", data, rate, data_type, taus, confidence, nan_policy)
+
+
+def oadev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+    """Overlapping Allan deviation, NIST SP 1065 eq. (11)::
+
+        sigma_y^2(tau) = sum_{i=0}^{N-2m-1} (x_{i+2m} - 2 x_{i+m} + x_i)^2 / (2 tau^2 (N - 2m)),
+
+    n = N - 2m terms, m = 1 .. (N - 1) / 2. Dimensionless.
+    {parameters}
+    References
+    ----------
+    W. J. Riley, NIST SP 1065, 2008, section 5.2.4.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.oadev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0], taus="all")
+    >>> res.averaging_factors.tolist(), res.n.tolist()
+    ([1, 2, 3], [6, 4, 2])
+    >>> res.deviation.round(6).tolist()
+    [1.118034, 0.707107, 1.118034]
+    """
+    return _estimate("oadev", data, rate, data_type, taus, confidence, nan_policy)
+
+
+def mdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+    """Modified Allan deviation, NIST SP 1065 eq. (14)::
+
+        Mod sigma_y^2(tau) = sum_{j=0}^{N-3m} [sum_{i=j}^{j+m-1} (x_{i+2m} - 2 x_{i+m} + x_i)]^2 / (2 m^2 tau^2 (N - 3m + 1)),
+
+    n = N - 3m + 1 terms, m = 1 .. N / 3. Dimensionless. Each level costs
+    O(N): the inner sums are third differences of the running sum of x.
+    {parameters}
+    References
+    ----------
+    W. J. Riley, NIST SP 1065, 2008, section 5.2.5.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.mdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0], taus="all")
+    >>> res.averaging_factors.tolist(), res.n.tolist(), res.deviation.round(6).tolist()
+    ([1, 2], [6, 3], [1.118034, 0.707107])
+    """
+    return _estimate("mdev", data, rate, data_type, taus, confidence, nan_policy)
+
+
+def tdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+    """Time deviation, NIST SP 1065 eq. (15): sigma_x(tau) = tau / sqrt(3) Mod sigma_y(tau), in seconds.
+
+    Same terms and levels as :func:`mdev`.
+    {parameters}
+    References
+    ----------
+    W. J. Riley, NIST SP 1065, 2008, section 5.2.6.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.tdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0], rate=2.0)
+    >>> res.taus.tolist(), res.deviation.round(6).tolist()  # 0.5 s / sqrt(3) * 1.118034, ...
+    ([0.5, 1.0], [0.322749, 0.408248])
+    """
+    return _estimate("tdev", data, rate, data_type, taus, confidence, nan_policy)
+
+
+def hdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+    """Hadamard deviation (non-overlapping), NIST SP 1065 eq. (18)::
+
+        H sigma_y^2(tau) = sum_{k} (x_{(k+3)m} - 3 x_{(k+2)m} + 3 x_{(k+1)m} - x_{km})^2 / (6 tau^2 n),
+
+    n = floor((N - 1) / m) - 2 terms, m = 1 .. (N - 1) / 3. Dimensionless;
+    insensitive to a linear frequency drift.
+    {parameters}
+    References
+    ----------
+    W. J. Riley, NIST SP 1065, 2008, section 5.2.8.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.hdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0, 6.0])  # the drift is ignored
+    >>> res.n.tolist(), res.deviation.round(6).tolist()
+    ([6, 2], [1.224745, 0.0])
+    """
+    return _estimate("hdev", data, rate, data_type, taus, confidence, nan_policy)
+
+
+def ohdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+    """Overlapping Hadamard deviation, NIST SP 1065 eq. (20)::
+
+        H sigma_y^2(tau) = sum_{i=0}^{N-3m-1} (x_{i+3m} - 3 x_{i+2m} + 3 x_{i+m} - x_i)^2 / (6 tau^2 (N - 3m)),
+
+    n = N - 3m terms, m = 1 .. (N - 1) / 3. Dimensionless.
+    {parameters}
+    References
+    ----------
+    W. J. Riley, NIST SP 1065, 2008, section 5.2.9.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.ohdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0, 6.0], taus="all")
+    >>> res.n.tolist(), res.deviation.round(6).tolist()
+    ([6, 3], [1.224745, 0.0])
+    """
+    return _estimate("ohdev", data, rate, data_type, taus, confidence, nan_policy)
+
+
+def totdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+    """Total deviation, NIST SP 1065 eq. (25)::
+
+        Tot sigma_y^2(tau) = sum_{i=2}^{N-1} (x*_{i-m} - 2 x*_i + x*_{i+m})^2 / (2 tau^2 (N - 2)),
+
+    with the phase extended by reflection at both ends, x*_{1-j} = 2 x_1 -
+    x_{1+j} and x*_{N+j} = 2 x_N - x_{N-j} (j = 1 .. N - 2); n = N - 2 terms
+    at every m = 1 .. N - 1 (the range where x* is defined, as
+    ``allantools.totdev``; Stable32 stops at half the record). Dimensionless.
+    No bias correction is applied (as ``allantools``).
+    {parameters}
+    References
+    ----------
+    D. A. Howe, "The total deviation approach to long-term characterization of
+    frequency stability", IEEE Trans. UFFC 47, 2000. W. J. Riley, NIST SP
+    1065, 2008, section 5.2.11.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.totdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0], taus=[1, 6])
+    >>> res.n.tolist(), res.deviation.round(6).tolist()
+    ([6, 6], [1.118034, 1.096079])
+    """
+    return _estimate("totdev", data, rate, data_type, taus, confidence, nan_policy)
+
+
+for _function in (adev, oadev, mdev, tdev, hdev, ohdev, totdev):
+    _function.__doc__ = _function.__doc__.replace("{parameters}", _PARAMETERS)
+del _function

@@ -1,0 +1,54 @@
+"""The compiled lag-1 noise identification against its plain NumPy twin."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avar._kernels.noise_id import lag1_alpha_decimated
+from avar.stability.noise_id import lag1_alpha
+
+
+def plain_alpha(x: np.ndarray, m: int, dmax: int) -> float:
+    """Decimate, remove the least-squares quadratic (numpy.polynomial), then the NumPy lag-1 rule."""
+    z = x[::m]
+    u = np.linspace(-1.0, 1.0, z.size)
+    trend = np.polynomial.polynomial.polyval(u, np.polynomial.polynomial.polyfit(u, z, 2))
+    return lag1_alpha(z - trend, dmax)
+
+
+def series(kind: str, n: int, seed: int) -> np.ndarray:
+    w = np.random.default_rng(seed).standard_normal(n)
+    drift = 1e3 + 0.5 * np.arange(n) + 1e-4 * np.arange(n) ** 2  # removed by both
+    return {"white pm": w, "white fm": np.cumsum(w), "rw fm": np.cumsum(np.cumsum(w))}[kind] + drift
+
+
+@pytest.mark.parametrize("kind", ["white pm", "white fm", "rw fm"])
+@pytest.mark.parametrize("dmax", [2, 3])
+def test_kernel_equals_the_numpy_twin(kind, dmax):
+    hits = 0
+    for seed in range(6):
+        x = series(kind, 5000, seed)
+        for m in (1, 2, 3, 7, 16, 64, 150):
+            got, expected = lag1_alpha_decimated(x, m, dmax), plain_alpha(x, m, dmax)
+            assert got == expected, (kind, seed, m)
+            hits += 1
+    assert hits == 42
+
+
+def test_constant_series_gives_nan():
+    assert np.isnan(lag1_alpha_decimated(np.full(100, 3.5), 1, 2))
+
+
+@pytest.mark.parametrize("factors", [[1, 2, 4, 8, 16, 32, 64, 128], [1, 3, 6, 7, 14, 100, 200], [5], [2, 4]])
+def test_levels_serial_split_and_single_agree(factors):
+    from avar._kernels.noise_id import lag1_levels, lag1_levels_split
+
+    x = series("white fm", 20_000, 1)
+    m = np.array(factors, dtype=np.int64)
+    serial, split = np.empty(m.size), np.empty(m.size)
+    lag1_levels(x, m, 2, serial)
+    lag1_levels_split(x, m, 2, split)
+    single = [lag1_alpha_decimated(x, int(f), 2) for f in m]
+    np.testing.assert_array_equal(serial, single)
+    np.testing.assert_array_equal(split, single)

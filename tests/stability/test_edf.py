@@ -1,0 +1,179 @@
+"""EDF and chi-squared bounds against allantools, Stable32 output and exact white-noise values."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from math import comb
+
+import allantools
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from avar.stability.edf import ESTIMATORS, chi2_bounds, estimator_edf, greenhall_edf, totdev_edf
+
+FACTORS = [1, 2, 3, 5, 8, 16, 33, 34, 50, 64, 100, 128, 300, 1000, 4096, 20000]
+LENGTHS = [10, 33, 100, 1001, 4097, 100_000]
+
+
+def allantools_edf(alpha, d, m, n, overlapping, modified):
+    """allantools.edf_greenhall, or None where it has no answer (white PM with K <= d, d = 3 alpha = -4)."""
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            return allantools.edf_greenhall(alpha, d, m, n, overlapping=overlapping, modified=modified)
+    except (NotImplementedError, AssertionError):
+        return None
+
+
+@pytest.mark.parametrize("estimator", sorted(ESTIMATORS))
+def test_estimator_edf_matches_allantools(estimator):
+    d, overlapping, modified = ESTIMATORS[estimator]
+    compared = 0
+    for n in LENGTHS:
+        factors = np.array([m for m in FACTORS if (m * (d + 1) if modified else m * d + 1) <= n])
+        for alpha in range(-2, 3):
+            ours = estimator_edf(estimator, np.full(factors.size, alpha), factors, n)
+            for m, value in zip(factors.tolist(), ours):
+                reference = allantools_edf(alpha, d, m, n, overlapping, modified)
+                if reference is not None:
+                    assert value == pytest.approx(reference, rel=1e-6), (n, m, alpha)
+                    compared += 1
+    assert compared > 150
+
+
+@pytest.mark.parametrize("alpha", [-4, -3])
+def test_hadamard_steep_noises_match_allantools(alpha):
+    for overlapping in (False, True):
+        for m in (1, 5, 33, 100):
+            reference = allantools_edf(alpha, 3, m, 4097, overlapping, False)
+            if reference is not None:
+                assert greenhall_edf(alpha, 3, m, 4097, overlapping, False) == pytest.approx(reference, rel=1e-6)
+
+
+def test_totdev_edf_matches_allantools_and_table_7():
+    n = 1001
+    for alpha in range(-2, 3):
+        factors = np.array([1, 2, 4, 16, 100, 333, 499])
+        ours = totdev_edf(n, factors, alpha)
+        with contextlib.redirect_stdout(io.StringIO()):
+            reference = np.array([allantools.edf_totdev(n, int(m), alpha) for m in factors], dtype=float)
+        usable = np.isfinite(reference) & (reference >= 1)
+        np.testing.assert_allclose(ours[usable], reference[usable], rtol=1e-6)
+        assert (ours >= 1).all()
+    # Table 7 by hand: random-walk FM, b = 0.93, c = 0.36
+    assert totdev_edf(1001, 10, -2) == pytest.approx(0.93 * 100.1 - 0.36, rel=1e-14)
+
+
+def white_pm_exact_edf(n, m, d, overlapping):
+    """(tr A)**2 / tr(A A) of the quadratic form of the unmodified estimator: exact for white phase."""
+    step = 1 if overlapping else m
+    starts = np.arange(0, n - d * m, step)
+    weights = np.array([(-1) ** k * comb(d, k) for k in range(d + 1)], dtype=float)
+    rows = np.zeros((starts.size, n))
+    for k, w in enumerate(weights):
+        rows[np.arange(starts.size), starts + k * m] = w
+    a = rows.T @ rows
+    return np.trace(a) ** 2 / np.sum(a * a)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+@pytest.mark.parametrize("overlapping", [False, True])
+def test_white_pm_is_exact_including_few_terms(d, overlapping):
+    # Includes K = ceil(M / S) <= d, where allantools raises NotImplementedError.
+    for n, m in [(10, 3), (13, 4), (20, 2), (40, 6), (64, 5), (64, 21), (33, 16)]:
+        if m * d + 1 > n:
+            continue
+        expected = white_pm_exact_edf(n, m, d, overlapping)
+        assert greenhall_edf(2, d, m, n, overlapping, False) == pytest.approx(expected, rel=1e-12), (n, m)
+
+
+def test_white_fm_unoverlapped_is_exact():
+    # m > 33: F = infinity, independent frequency averages; the M differences of order d
+    # are correlated only between neighbours.
+    n = 1001
+    for m in (34, 50, 100, 250):
+        terms = (n - 1) // m - 1
+        assert greenhall_edf(0, 2, m, n, False, False) == pytest.approx(2 * terms**2 / (3 * terms - 1), rel=1e-12)
+        terms -= 1
+        correlation = terms + 2 * (terms - 1) * (4 / 6) ** 2 + 2 * (terms - 2) * (1 / 6) ** 2
+        assert greenhall_edf(0, 3, m, n, False, False) == pytest.approx(terms**2 / correlation, rel=1e-12)
+
+
+# Stable32 1.60 on its PHASE.DAT (N = 1001 phase points), alpha = 0, confidence 0.683:
+# (m, min sigma, sigma, max sigma), as published with allantools' tests.
+STABLE32 = {
+    "adev": [(1, 2.8515e-01, 2.9223e-01, 2.9987e-01), (8, 1.0254e-01, 1.1013e-01, 1.1971e-01),
+             (64, 2.7109e-02, 3.2550e-02, 4.3537e-02), (128, 2.6481e-02, 3.3855e-02, 5.5744e-02)],
+    "oadev": [(2, 1.9520e-01, 2.0102e-01, 2.0738e-01), (16, 5.7696e-02, 6.1915e-02, 6.7217e-02),
+              (128, 2.3045e-02, 2.7674e-02, 3.7027e-02)],
+    "mdev": [(2, 1.5336e-01, 1.5821e-01, 1.6355e-01), (32, 3.0466e-02, 3.4255e-02, 3.9933e-02),
+             (128, 1.4874e-02, 1.8669e-02, 2.8584e-02)],
+    "tdev": [(4, 2.3838e-01, 2.4895e-01, 2.6106e-01), (128, 1.0992e+00, 1.3797e+00, 2.1124e+00)],
+    "hdev": [(2, 1.9887e-01, 2.0716e-01, 2.1659e-01), (32, 4.6987e-02, 5.4697e-02, 6.8092e-02),
+             (128, 2.8841e-02, 3.8060e-02, 7.3807e-02)],
+    "ohdev": [(1, 2.8635e-01, 2.9439e-01, 3.0315e-01), (16, 5.6173e-02, 6.0638e-02, 6.6369e-02),
+              (128, 2.3761e-02, 2.9147e-02, 4.1367e-02)],
+    "totdev": [(1, 2.8707e-01, 2.9223e-01, 2.9768e-01), (32, 4.4255e-02, 4.8580e-02, 5.4484e-02),
+               (256, 1.0734e-02, 1.3369e-02, 1.9924e-02)],
+}
+
+
+@pytest.mark.parametrize("estimator", sorted(STABLE32))
+def test_bounds_match_stable32(estimator):
+    rows = np.array(STABLE32[estimator])
+    factors, low, sigma, high = rows[:, 0].astype(int), rows[:, 1], rows[:, 2], rows[:, 3]
+    edf = estimator_edf(estimator, np.zeros(factors.size, dtype=int), factors, 1001)
+    lci, uci = chi2_bounds(sigma, edf, 0.683)
+    # Stable32 prints 5 significant digits and its own chi-squared quantiles: agreement to
+    # 5.6e-4 (allantools checks the same table to 1e-3)
+    np.testing.assert_allclose(lci, low, rtol=1e-3)
+    np.testing.assert_allclose(uci, high, rtol=1e-3)
+    # an EDF off by 20% would not pass
+    assert not np.allclose(chi2_bounds(sigma, 0.8 * edf, 0.683)[0], low, rtol=1e-3)
+
+
+def test_chi2_bounds_match_allantools():
+    for edf in (1.0, 1.7, 4.2, 30.0, 999.0, 1e6):
+        for confidence in (0.5, 0.683, allantools.ci.ONE_SIGMA_CI, 0.9, 0.95, 0.999):
+            lci, uci = chi2_bounds(0.37, edf, confidence)
+            low, high = allantools.confidence_interval(0.37, edf, confidence)
+            assert lci == pytest.approx(low, rel=1e-9) and uci == pytest.approx(high, rel=1e-9)
+            assert 0 < lci <= 0.37 <= uci
+
+
+def test_chi2_bounds_vectorized_and_extreme_confidence():
+    deviation = np.array([0.0, 1.0, 2.0])
+    lci, uci = chi2_bounds(deviation, np.array([3.0, 3.0, 3.0]))
+    assert lci[0] == uci[0] == 0.0 and lci[2] == pytest.approx(2 * lci[1], rel=1e-15)
+    # 1 - 1e-13: ppf(1 - q) would lose the tail; the bounds still hold their probability
+    lci, uci = chi2_bounds(1.0, 10.0, confidence=1 - 1e-13)
+    assert chi2.sf(10.0 / lci**2, 10.0) == pytest.approx(0.5e-13, rel=1e-6)
+    assert chi2.cdf(10.0 / uci**2, 10.0) == pytest.approx(0.5e-13, rel=1e-6)
+    assert 0 < lci < 1 < uci < np.inf
+    assert np.isnan(chi2_bounds(1.0, np.nan)[0])
+
+
+@pytest.mark.parametrize(
+    "call, error, message",
+    [
+        (lambda: estimator_edf("avar", [0], [1], 100), ValueError, "estimator must be one of"),
+        (lambda: estimator_edf("adev", [3], [1], 100), ValueError, "alpha must"),
+        (lambda: estimator_edf("adev", [0.5], [1], 100), TypeError, "alpha must be an integer"),
+        (lambda: estimator_edf("adev", [0], [0], 100), ValueError, "averaging factors >= 1"),
+        (lambda: estimator_edf("adev", [0], [50], 100), ValueError, "too large for n_phase = 100"),
+        (lambda: estimator_edf("adev", [0, 0], [1, 2, 3], 100), ValueError, "must broadcast"),
+        (lambda: greenhall_edf(-1, 1, 2, 100, False, False), ValueError, r"alpha \+ 2 d > 1"),
+        (lambda: greenhall_edf(0, 4, 2, 100, False, False), ValueError, "d must be 1, 2 or 3"),
+        (lambda: greenhall_edf(0, 2, 2, 100, 1, False), TypeError, "overlapping must be True or False"),
+        (lambda: totdev_edf(100, 100, 0), ValueError, "m must be < n_phase"),
+        (lambda: totdev_edf(1.5, 1, 0), ValueError, "n_phase must be an integer"),
+        (lambda: chi2_bounds(1.0, 0.0), ValueError, "edf must be positive"),
+        (lambda: chi2_bounds(-1.0, 3.0), ValueError, "deviation must be finite and >= 0"),
+        (lambda: chi2_bounds(1.0, 3.0, confidence=1.0), ValueError, "confidence must be a number in"),
+        (lambda: chi2_bounds("a", 3.0), TypeError, "deviation must be a real"),
+    ],
+)
+def test_validation_names_the_argument(call, error, message):
+    with pytest.raises(error, match=message):
+        call()

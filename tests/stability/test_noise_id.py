@@ -1,0 +1,136 @@
+"""Power-law noise identification on exactly simulated noise, and against allantools."""
+
+from __future__ import annotations
+
+import allantools
+import numpy as np
+import pytest
+from allantools import ci as atci
+from powerlaw import powerlaw_phase
+
+from avar.stability.noise_id import b1_alpha, b1_theory, identify_noise, rn_boundary
+
+ALPHAS = [2, 1, 0, -1, -2]
+N = 2**13
+
+
+@pytest.fixture(scope="module")
+def series():
+    return {(alpha, seed): powerlaw_phase(N, alpha, seed) for alpha in ALPHAS for seed in range(10)}
+
+
+@pytest.mark.parametrize("estimator", ["oadev", "mdev", "hdev", "totdev"])
+@pytest.mark.parametrize("alpha", ALPHAS)
+def test_identifies_simulated_power_laws(series, estimator, alpha):
+    factors = np.array([1, 2, 4])
+    found = np.array([identify_noise(series[alpha, seed], factors, estimator) for seed in range(10)])
+    hits = (found == alpha).sum(axis=0)
+    assert (hits >= 9).all(), (alpha, hits, found)
+
+
+def test_powerlaw_helper_has_the_allan_slopes():
+    # sanity of the simulator: ADEV slopes tau**mu, mu = -1, -1, -1/2, 0, 1/2 (flicker PM: ~ -1)
+    slopes = {}
+    for alpha in ALPHAS:
+        x = powerlaw_phase(2**16, alpha, 0)
+        _, dev, _, _ = allantools.oadev(x, taus=[16, 256], data_type="phase")
+        slopes[alpha] = np.log(dev[1] / dev[0]) / np.log(16)
+    assert slopes[2] == pytest.approx(-1, abs=0.05)
+    assert slopes[1] == pytest.approx(-1, abs=0.15)
+    assert slopes[0] == pytest.approx(-0.5, abs=0.1)
+    assert slopes[-1] == pytest.approx(0, abs=0.15)
+    assert slopes[-2] == pytest.approx(0.5, abs=0.15)
+
+
+@pytest.mark.parametrize("estimator, dmax", [("adev", 2), ("ohdev", 3)])
+def test_lag1_agrees_with_allantools(series, estimator, dmax):
+    factors = [1, 2, 4, 16, 64, 256]  # N / m >= 30: the lag-1 method in both
+    compared = 0
+    for (alpha, seed), x in series.items():
+        if seed >= 4:
+            continue
+        ours = identify_noise(x, factors, estimator)
+        theirs = [atci.autocorr_noise_id(x, m, data_type="phase", dmax=dmax)[0] for m in factors]
+        np.testing.assert_array_equal(ours, np.clip(theirs, -2, 2), err_msg=f"alpha={alpha} seed={seed}")
+        compared += len(factors)
+    assert compared == 120
+
+
+def reference_b1_alpha(x, m):
+    """allantools' B1 ratio and boundaries; R(n) from its full ADEV and MDEV."""
+    b1 = atci.b1(x, m, 1.0)
+    k = (len(x) - 1) // m
+    for b_hi, alpha in ((-3, -2), (-2, -1), (-1, 0)):
+        if b1 > atci.b1_boundary(b_hi, k):
+            return alpha
+    return 1 if atci.rn(x, m, 1.0) > atci.rn_boundary(m, 0) else 2
+
+
+def test_b1_fallback_agrees_with_allantools_b1_and_rn():
+    agree = total = 0
+    for alpha in ALPHAS:
+        for seed in range(8):
+            x = powerlaw_phase(2049, alpha, 100 + seed)
+            for m in (128, 256, 512):  # 16, 8 and 4 averages: fewer than 30 points
+                cumsum = np.concatenate(([0.0], np.cumsum(x)))
+                agree += b1_alpha(x, cumsum, m) == reference_b1_alpha(x, m)
+                total += 1
+    # the B1 decisions are the same statistic; R(n) here samples MVAR at 64 offsets per cluster
+    assert agree >= 0.95 * total, (agree, total)
+
+
+def test_b1_fallback_identifies_clear_cases():
+    hits = {alpha: 0 for alpha in (2, -2)}
+    for alpha in hits:
+        for seed in range(10):
+            x = powerlaw_phase(2**14, alpha, 200 + seed)
+            hits[alpha] += identify_noise(x, [29 * 16], "oadev")[0] == alpha  # 35 points: lag-1
+            hits[alpha] += identify_noise(x, [680], "oadev")[0] == alpha  # 24 averages: B1
+    assert hits[2] >= 16 and hits[-2] >= 16, hits
+
+
+def test_b1_theory_and_rn_boundary_values():
+    # Barnes: B1(N, mu) = N (1 - N**mu) / (2 (N - 1) (1 - 2**mu)), limits at mu = 0, -1
+    for k in (3, 10, 100):
+        assert b1_theory(k, 1) == pytest.approx(k * (1 - k) / (2 * (k - 1) * (1 - 2)))
+        assert b1_theory(k, -2) == pytest.approx(k * (1 - k**-2.0) / (2 * (k - 1) * (1 - 2**-2.0)))
+        assert b1_theory(k, 0) == pytest.approx(k * np.log(k) / (2 * (k - 1) * np.log(2)))
+        assert b1_theory(k, -1) == 1.0
+    for m in (2, 100, 5000):
+        assert rn_boundary(m) == pytest.approx(atci.rn_boundary(m, 0), rel=1e-12)
+
+
+def test_levels_without_enough_data_take_the_previous_level():
+    x = powerlaw_phase(200, -2, 3)
+    factors = np.array([1, 2, 80, 99])  # 80, 99: 2 averages, no B1
+    alpha = identify_noise(x, factors, "adev")
+    assert alpha[2] == alpha[3] == alpha[1]
+    # shuffled factors give the same per-factor answers
+    np.testing.assert_array_equal(identify_noise(x, factors[::-1], "adev"), alpha[::-1])
+    # nothing identifiable (constant phase): white FM by convention
+    np.testing.assert_array_equal(identify_noise(np.zeros(10), [1, 2, 4], "adev"), [0, 0, 0])
+
+
+def test_result_is_clipped_and_integer():
+    x = np.cumsum(np.cumsum(powerlaw_phase(4096, -2, 0)))  # steeper than random-walk FM
+    alpha = identify_noise(x, [1, 2, 4], "hdev")
+    assert alpha.dtype == np.int64 and (alpha == -2).all()
+    rng = np.random.default_rng(0)
+    blue = np.diff(rng.standard_normal(4097))  # bluer than white PM
+    assert (identify_noise(blue, [1], "adev") == 2).all()
+
+
+@pytest.mark.parametrize(
+    "args, error, message",
+    [
+        ((np.ones((3, 3)), [1], "adev"), TypeError, "phase must be a 1-D array"),
+        ((np.ones(3), [1], "adev"), ValueError, "at least 4 points"),
+        ((np.r_[1.0, np.nan, 1, 1, 1], [1], "adev"), ValueError, "finite and gap-free; first bad value at index 1"),
+        ((np.ones(10), [0], "adev"), ValueError, r"factors must be in 1 .. 9"),
+        ((np.ones(10), [1.5], "adev"), TypeError, "factors must be a 1-D array of integer"),
+        ((np.ones(10), [1], "avar"), ValueError, "estimator must be one of"),
+    ],
+)
+def test_validation(args, error, message):
+    with pytest.raises(error, match=message):
+        identify_noise(*args)
