@@ -119,6 +119,14 @@ def test_import_avar_loads_no_heavy_dependency():
     assert [m for m in loaded if m.startswith("avar.")] == []
 
 
+def test_allan_variance_of_an_array_loads_no_pandas():
+    # pandas (and the pyarrow it loads) is ~100 MB of resident memory: only tables and pandas inputs need it
+    code = ("import sys, numpy as np, avar; x = np.random.default_rng(0).standard_normal(5000); "
+            "avar.avar(x); avar.avar(x, type='to', ci='chi2'); print(sorted({m.split('.')[0] for m in sys.modules}))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert "'numpy'" in loaded and "'pandas'" not in loaded and "'pyarrow'" not in loaded
+
+
 def test_public_names_resolve_lazily():
     import avar
 

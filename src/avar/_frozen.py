@@ -4,10 +4,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:  # pandas loads with the first Series or frame
+    import pandas as pd
 
 
 def frozen_array(values: Any, dtype: type = np.float64) -> np.ndarray:
@@ -18,11 +20,15 @@ def frozen_array(values: Any, dtype: type = np.float64) -> np.ndarray:
 
 
 def frozen_series(series: pd.Series) -> pd.Series:
+    import pandas as pd
+
     """A copy of a float Series whose values cannot be assigned to."""
     return pd.Series(frozen_array(series.to_numpy()), index=series.index.copy(), name=series.name, copy=False)
 
 
 def frozen_frame(frame: pd.DataFrame) -> pd.DataFrame:
+    import pandas as pd
+
     """A copy of a float DataFrame whose values cannot be assigned to."""
     values = np.array(frame.to_numpy(dtype=np.float64), copy=True)
     values.flags.writeable = False

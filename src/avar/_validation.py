@@ -8,10 +8,10 @@ value) with a message that says what was wrong and what is accepted.
 from __future__ import annotations
 
 import numbers
+import sys
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 MIN_SAMPLES = 4
 
@@ -95,9 +95,7 @@ def as_array(x: Any, what: str) -> np.ndarray:
 
 def integer_range(array: np.ndarray) -> tuple[int, int] | None:
     """(min, max) of an integer array as Python ints, or None for other dtypes."""
-    if array.dtype.kind not in "iu" or array.size == 0:
-        return None
-    return int(array.min()), int(array.max())
+    return None if array.dtype.kind not in "iu" or array.size == 0 else (int(array.min()), int(array.max()))
 
 
 def as_float64(array: np.ndarray) -> np.ndarray:
@@ -280,7 +278,7 @@ def _rate_from_seconds(seconds: np.ndarray, what: str) -> float:
     return rate
 
 
-def rate_from_index(index: pd.Index, what: str) -> float | None:
+def rate_from_index(index: Any, what: str) -> float | None:
     """Sampling rate (Hz) of a time index: regular Datetime/Timedelta, Period, or float seconds.
 
     A float index holds times in seconds: its rate is 1 / the mean step (see
@@ -289,6 +287,7 @@ def rate_from_index(index: pd.Index, what: str) -> float | None:
     RangeIndex or integer index numbers samples, it does not time them); raises
     ValueError for an irregular Datetime/Timedelta index or a float index with gaps.
     """
+    import pandas as pd  # an index is a pandas object: pandas is loaded already
     if isinstance(index, pd.PeriodIndex) and len(index) >= 2:
         index = index.to_timestamp()
     if index.dtype.kind == "f" and len(index) >= 2:
@@ -307,19 +306,31 @@ def rate_from_index(index: pd.Index, what: str) -> float | None:
     return 1e9 / float(step_ns)
 
 
-def as_series(x: Any, freq: Any) -> tuple[np.ndarray, float]:
+def native_values(array: np.ndarray) -> np.ndarray | None:
+    """``array`` itself when valid as it is, else None: integers, booleans, float32/64 (magnitudes near the
+    float64 limit are the kernels' to rescale). Up to 2**20 floats, the sum must be finite (so every value
+    is); beyond, the kernels' own pass finds a non-finite value (:func:`check_finite` then reports it)."""
+    if array.dtype.kind in "biu" or (array.dtype.kind == "f" and array.itemsize >= 4 and array.size > 2**20):
+        return array
+    with np.errstate(over="ignore", invalid="ignore"):
+        return array if array.dtype.kind == "f" and array.itemsize >= 4 and np.isfinite(array.sum()) else None
+
+
+def as_series(x: Any, freq: Any, native: bool = False) -> tuple[np.ndarray, float]:
     """Validate a 1-D series and its rate; return float64 values and freq.
 
     Integers spanning 2**53 or more are returned as integers (see :func:`as_float64`).
+    ``native=True`` (for kernels that read any real dtype in place) returns integer, boolean and
+    float32 arrays as they are, never copied to float64 (see :func:`native_values`).
 
     ``freq=None`` means the rate of a pandas time index when there is one,
     otherwise 1 Hz.
     """
-    what = "x"
-    index_rate = None
-    if isinstance(x, pd.DataFrame):
+    what, index_rate = "x", None
+    pd = sys.modules.get("pandas")  # not loaded: x cannot be a pandas object, and stays light
+    if pd is not None and isinstance(x, pd.DataFrame):
         raise TypeError("x is a DataFrame; give a 1-D series or an avar.IMU (see avar.IMU.from_dataframe)")
-    if isinstance(x, pd.Series):
+    if pd is not None and isinstance(x, pd.Series):
         index_rate = rate_from_index(x.index, what) if freq is None else None
         x = x.to_numpy()
     if isinstance(x, (str, bytes)):
@@ -327,12 +338,12 @@ def as_series(x: Any, freq: Any) -> tuple[np.ndarray, float]:
     array = as_array(x, what)
     check_numeric_dtype(array, what)
     if array.ndim != 1:
-        raise ValueError(
-            f"x must be 1-D, got an array of shape {array.shape}; give a 1-D series or an avar.IMU"
-        )
+        raise ValueError(f"x must be 1-D, got an array of shape {array.shape}; give a 1-D series or an avar.IMU")
     check_length(array.shape[0], what)
-    values = shift_huge(as_float64(array))
-    check_finite(values, what)
+    values = native_values(array) if native else None
+    if values is None:
+        values = shift_huge(as_float64(array))
+        check_finite(values, what)
     if freq is None:
         rate = index_rate if index_rate is not None else 1.0
     else:

@@ -9,13 +9,16 @@ Allan variance of all channels in one pass of the kernels.
 from __future__ import annotations
 
 import numbers
+import sys
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:  # pandas loads only for frames and Series
+    import pandas as pd
 
 from avar._validation import (
     EXACT_INTEGER_LIMIT,
@@ -221,7 +224,8 @@ class IMU:
         name: str | None = None,
         units: Mapping[str, str] | None = None,
     ) -> None:
-        if isinstance(data, pd.DataFrame):
+        pd = sys.modules.get("pandas")  # not loaded: data cannot be a pandas object
+        if pd is not None and isinstance(data, pd.DataFrame):
             columns = tuple(str(c) for c in data.columns)
             if len(set(columns)) != len(columns):
                 repeated = sorted({c for c in columns if columns.count(c) > 1})
@@ -235,7 +239,7 @@ class IMU:
             integers = all(pd.api.types.is_integer_dtype(dt) and dt.kind in "iu" for dt in data.dtypes)
             array = data.to_numpy() if integers else data.to_numpy(dtype=np.float64, na_value=np.nan)
         else:
-            if isinstance(data, pd.Series):
+            if pd is not None and isinstance(data, pd.Series):
                 raise ValueError("data is a single Series; use avar.avar(series) for one channel, or give a DataFrame")
             columns = None
             array = as_array(data, "data")
@@ -320,6 +324,8 @@ class IMU:
         >>> imu.freq, imu.sensor_types
         (100.0, ('Gyroscope', 'Accelerometer'))
         """
+        import pandas as pd
+
         if not isinstance(df, pd.DataFrame):
             raise TypeError(f"df must be a pandas DataFrame, got {type(df).__name__}")
         if freq is None:
@@ -346,6 +352,8 @@ class IMU:
 
     def to_dataframe(self) -> pd.DataFrame:
         """The samples as a DataFrame with the channel names, indexed by time in seconds."""
+        import pandas as pd
+
         index = pd.Index(np.arange(self.n) / self.freq, name="Time")
         return pd.DataFrame(np.array(self.data), index=index, columns=list(self.channels))
 
