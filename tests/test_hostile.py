@@ -324,3 +324,24 @@ def test_integers_spanning_their_whole_range_are_not_converted_lossily(dtype):
     result = avar.avar(x, taus="all")
     exact = np.array([float(_exact_moav([int(v) for v in x], int(m))) for m in result.averaging_factors])
     np.testing.assert_allclose(result.allan, exact, rtol=0, atol=1e-12 * exact.max())
+
+
+def test_the_reported_int64_example_is_exact():
+    # the centring offset of this series overflowed int64 once, and the AV came out 3x off
+    x = np.array([2**63 - 1, -(2**63), 0, 5, 2**62, -(2**62)] * 4, dtype=np.int64)
+    result = avar.avar(x, taus="all")
+    exact = np.array([float(_exact_moav([int(v) for v in x], int(m))) for m in result.averaging_factors])
+    np.testing.assert_allclose(result.allan, exact, rtol=1e-12, atol=0)
+
+
+def test_cli_int64_npy_near_the_int64_limit_is_exact(tmp_path, capsys):
+    # near 2**63 - 1 a float64 conversion rounds every sample to the same value (AV 0)
+    steps = np.random.default_rng(5).integers(0, 1000, 64)
+    x = (np.iinfo(np.int64).max - steps).astype(np.int64)
+    np.save(tmp_path / "big.npy", x)
+    code, _, err = cli(capsys, "compute", tmp_path / "big.npy", "--taus", "all", "--output", tmp_path / "o.csv")
+    assert code == 0, err
+    table = pd.read_csv(tmp_path / "o.csv")
+    exact = np.array([float(_exact_moav([int(v) for v in x], m)) for m in range(1, 33)])
+    assert exact.min() > 0
+    np.testing.assert_allclose(table["AVar"], exact, rtol=1e-12, atol=0)
