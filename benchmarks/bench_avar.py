@@ -32,9 +32,9 @@ import subprocess
 import sys
 import tempfile
 import textwrap
-import time
 
 import numpy as np
+from timing import median_time  # benchmarks/timing.py
 
 import avar
 from avar.stability.grids import averaging_factors
@@ -43,16 +43,6 @@ try:
     import allantools
 except ImportError:  # pragma: no cover - the "bench" extra
     allantools = None
-
-
-def median_time(function, repeat: int) -> float:
-    function()  # warm-up (numba compilation, page cache)
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return float(np.median(times))
 
 
 def numpy_cumsum_avar(x: np.ndarray, factors: np.ndarray, type: str) -> np.ndarray:

@@ -31,10 +31,10 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
-import time
 import warnings
 
 import numpy as np
+from timing import median_time  # benchmarks/timing.py
 
 import avar
 from avar.stability.deviation_core import deviation_levels
@@ -51,16 +51,6 @@ GREENHALL = {"adev": (2, False, False), "oadev": (2, True, False), "mdev": (2, T
              "tdev": (2, True, True), "hdev": (3, False, False), "ohdev": (3, True, False)}
 TARGET = 3.0
 ACCEPTANCE_N = 10**6
-
-
-def median_time(function, repeat: int) -> float:
-    function()
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return float(np.median(times))
 
 
 def allantools_alpha(x: np.ndarray, m: int, rate: float, dmax: int) -> int:

@@ -38,6 +38,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from avar._kernels.streaming import _fast_sum, _two_sum
+
 #: Number of differences one parallel task sums (tasks are (channel, level,
 #: chunk) triples; the chunk size fixes the summation order, so results do
 #: not depend on the number of threads).
@@ -53,15 +55,6 @@ FUSED_BLOCK = 1 << 16
 #: Grids with more levels than this (such as taus="all") go level by level:
 #: their per-level work is large and the fused per-block table would be too.
 FUSED_MAX_LEVELS = 128
-
-
-@njit(cache=True, inline="always")
-def _two_sum(a, b):
-    """Knuth's TwoSum: ``a + b == s + e`` exactly."""
-    s = a + b
-    bv = s - a
-    e = (a - (s - bv)) + (b - bv)
-    return s, e
 
 
 @njit(cache=True, inline="always")
@@ -141,14 +134,6 @@ def centred_cumsum(data, centre, scale, hi, lo, block=CUMSUM_BLOCK):
 BLOCK = 512
 
 
-@njit(cache=True, fastmath=True)
-def _sum(buffer, count):
-    total = 0.0
-    for j in range(count):
-        total += buffer[j]
-    return total
-
-
 @njit(cache=True)
 def _contiguous_squares(hi, lo, m, start, count, buffer):
     """Sum of ``D_k**2`` for ``k = start .. start + count - 1`` with stride 1.
@@ -167,7 +152,7 @@ def _contiguous_squares(hi, lo, m, start, count, buffer):
         # rounding is ~6e-8 of a quantity already ~1e-16 of the cumulative sum.
         d = ((h2[j] - h1[j]) - (h1[j] - h0[j])) + np.float64((l2[j] - l1[j]) - (l1[j] - l0[j]))
         buffer[j] = d * d
-    return _sum(buffer, count)
+    return _fast_sum(buffer, count)
 
 
 @njit(cache=True)
@@ -179,7 +164,7 @@ def _strided_squares(hi, lo, m, stride, start, count, buffer):
             (lo[b + 2 * m] - lo[b + m]) - (lo[b + m] - lo[b])
         )
         buffer[j] = d * d
-    return _sum(buffer, count)
+    return _fast_sum(buffer, count)
 
 
 @njit(cache=True, parallel=True, nogil=True)

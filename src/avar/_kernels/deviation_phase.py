@@ -13,14 +13,7 @@ import numpy as np
 from numba import njit, prange
 
 from avar._kernels.allan import CUMSUM_BLOCK
-
-
-@njit(cache=True, inline="always")
-def _two_sum(a, b):
-    s = a + b
-    bv = s - a
-    e = (a - (s - bv)) + (b - bv)
-    return s, e
+from avar._kernels.streaming import _two_sum
 
 
 @njit(cache=True)

@@ -50,8 +50,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from avar._kernels.allan import squared_difference_sums
+from avar._kernels.allan import _contiguous_squares, squared_difference_sums
 from avar._kernels.deviation_phase import detrended_phase, scan  # noqa: F401 (re-exported)
+from avar._kernels.streaming import _fast_sum
 
 #: Terms per parallel task (MDEV tasks span at least m terms).
 CHUNK = 1 << 15
@@ -145,29 +146,6 @@ def _valid(code, bad, mode, b, m, last):
     return True
 
 
-@njit(cache=True, fastmath=True)
-def _sum(buffer, count):
-    total = 0.0
-    for j in range(count):
-        total += buffer[j]
-    return total
-
-
-@njit(cache=True)
-def _contiguous_second(hi, lo, m, start, count, buffer):
-    """Sum of squared second differences at ``b = start .. start + count - 1`` (vectorized)."""
-    h0 = hi[start : start + count]
-    h1 = hi[start + m : start + m + count]
-    h2 = hi[start + 2 * m : start + 2 * m + count]
-    l0 = lo[start : start + count]
-    l1 = lo[start + m : start + m + count]
-    l2 = lo[start + 2 * m : start + 2 * m + count]
-    for j in range(count):
-        d = ((h2[j] - h1[j]) - (h1[j] - h0[j])) + np.float64((l2[j] - l1[j]) - (l1[j] - l0[j]))
-        buffer[j] = d * d
-    return _sum(buffer, count)
-
-
 @njit(cache=True)
 def _contiguous_third(hi, lo, m, start, count, buffer):
     """Third differences at ``b = start .. start + count - 1`` into ``buffer`` (vectorized)."""
@@ -193,7 +171,7 @@ def _contiguous_third(hi, lo, m, start, count, buffer):
 def _squares(buffer, count):
     for j in range(count):
         buffer[j] = buffer[j] * buffer[j]
-    return _sum(buffer, count)
+    return _fast_sum(buffer, count)
 
 
 @njit(cache=True)
@@ -211,7 +189,7 @@ def _totdev_block(hi, lo, m, start, count, left, right, buffer):
     l0 = np.float64(lo[0])
     ll = np.float64(lo[last])
     if not left and not right:
-        return _contiguous_second(hi, lo, m, start - m, count, buffer)
+        return _contiguous_squares(hi, lo, m, start - m, count, buffer)
     for j in range(count):
         k = start + j
         hk = hi[k]
@@ -230,7 +208,7 @@ def _totdev_block(hi, lo, m, start, count, left, right, buffer):
             e = np.float64(lo[k + m]) - lk
         d = (a + c) + (b + e)
         buffer[j] = d * d
-    return _sum(buffer, count)
+    return _fast_sum(buffer, count)
 
 
 @njit(cache=True)
@@ -251,7 +229,7 @@ def _fast_task_sum(hi, lo, code, m, stride, first, last_term, buffer):
         count = min(BLOCK, last_term - start)
         if stride == 1:
             if code == 0:
-                total += _contiguous_second(hi, lo, m, start, count, buffer)
+                total += _contiguous_squares(hi, lo, m, start, count, buffer)
             else:
                 _contiguous_third(hi, lo, m, start, count, buffer)
                 total += _squares(buffer, count)
@@ -260,7 +238,7 @@ def _fast_task_sum(hi, lo, code, m, stride, first, last_term, buffer):
                 b = (start + j) * stride
                 d = _second(hi, lo, b, m) if code == 0 else _third(hi, lo, b, m)
                 buffer[j] = d * d
-            total += _sum(buffer, count)
+            total += _fast_sum(buffer, count)
     return total
 
 
@@ -289,7 +267,7 @@ def _task_sum(hi, lo, code, m, stride, first, last_term, mode, bad, buffer):
             else:
                 used += 1
             buffer[j] = d * d
-        total += _sum(buffer, count)
+        total += _fast_sum(buffer, count)
     return total, used
 
 

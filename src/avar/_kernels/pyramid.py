@@ -19,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from avar._kernels.deviation_phase import _increment, _two_sum
+from avar._kernels.deviation_phase import _increment
+from avar._kernels.streaming import _two_sum
 
 _NO_LO = np.zeros(1, dtype=np.float32)
 
