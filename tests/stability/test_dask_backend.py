@@ -53,3 +53,24 @@ def test_local_cluster_threads_and_files(tmp_path):
         x = np.load(path)
         np.testing.assert_array_equal(factors, octave(x.size))
         np.testing.assert_array_equal(allan, allan_variance_columns(x, factors, "to"))
+
+
+def test_avar_of_a_dask_array_is_the_numpy_result():
+    import avar
+
+    x = np.random.default_rng(8).standard_normal(1_000_000)
+    for type in ("mo", "to"):
+        got = avar.avar(da.from_array(x, chunks=x.size // 16), type=type, freq=50.0, taus="decade")
+        want = avar.avar(x, type=type, freq=50.0, taus="decade")
+        np.testing.assert_allclose(got.allan, want.allan, rtol=1e-12)
+        np.testing.assert_array_equal(got.levels, want.levels)
+        np.testing.assert_array_equal(got.n_differences, want.n_differences)
+        assert got.n == x.size and got.freq == 50.0
+    y = x.copy()
+    y[123_456] = np.nan
+    with pytest.raises(ValueError, match=r"x \(a Dask array\) holds NaN or infinite values"):
+        avar.avar(da.from_array(y, chunks=100_000))
+    with pytest.raises(ValueError, match="a Dask array takes ci='r' and nan_policy='raise'"):
+        avar.avar(da.from_array(x, chunks=100_000), ci="chi2")
+    with pytest.raises(ValueError, match="x must be 1-D"):
+        avar.avar(da.ones((100, 2), chunks=50))

@@ -7,11 +7,20 @@ the loops in :mod:`avar._kernels`, reached through
 
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 import numpy as np
 
-from avar._validation import SHIFT_LIMIT, as_float64, as_series, shift_huge
+from avar._validation import (
+    SHIFT_LIMIT,
+    as_float64,
+    as_series,
+    check_freq,
+    check_length,
+    check_numeric_dtype,
+    shift_huge,
+)
 from avar.imu import IMU
 from avar.stability.columns import allan_variance_columns
 from avar.stability.grids import averaging_factors, check_type, n_differences
@@ -42,10 +51,12 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
 
     Parameters
     ----------
-    x : array_like, pandas.Series or avar.IMU
-        1-D real series (any real dtype, computed in float64). A Series with a
-        regular DatetimeIndex or TimedeltaIndex gives the sampling rate when
-        ``freq`` is omitted.
+    x : array_like, pandas.Series, avar.IMU or dask.array.Array
+        1-D real series (any real dtype, read in place; memory maps stream). A
+        Series with a regular DatetimeIndex or TimedeltaIndex gives the
+        sampling rate when ``freq`` is omitted. A 1-D Dask array is computed
+        chunk by chunk on the active scheduler (a ``distributed.Client``
+        included), to the same values (see :mod:`avar.stability.dask_backend`).
     type : {"mo", "to"}
         Estimator.
     freq : float, optional
@@ -111,6 +122,8 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
     """
     kind = check_type(type)
     band = check_ci(ci, confidence)
+    if _is_dask_array(x):
+        return _dask_allan_variance(x, freq, kind, taus, band, nan_policy)
     if nan_policy != "raise":  # checked, and gaps computed, by the deviation family's kernels: loaded on demand
         from avar.stability.gaps import allan_variance_with_gaps, check_nan_policy, series_with_gaps
 
@@ -144,7 +157,8 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
 
 
 def allan_variance_table(
-    data: np.ndarray, names: tuple, freq: float, type: str, taus: Any, band: tuple = ("r", None)
+    data: np.ndarray, names: tuple, freq: float, type: str, taus: Any, band: tuple = ("r", None),
+    columns: Any = None,
 ) -> dict[Any, AllanVariance]:
     """Allan variance of every column of a validated (N, C) table, keyed by column name.
 
@@ -152,10 +166,11 @@ def allan_variance_table(
     of its channels, and every column shares the tau grid and one pass of the
     kernels; each column's result equals that of the column alone. ``band``
     is (ci, confidence): with "chi2" each column also gets its chi-squared band.
+    ``columns`` computes the (C, L) Allan variances (default the kernels; the Dask backend for Dask arrays).
     """
     n = data.shape[0]
     factors = averaging_factors(n, freq, taus)
-    allan = allan_variance_columns(data, factors, type)
+    allan = (columns or allan_variance_columns)(data, factors, type)
     levels = factors / freq
     errors = relative_errors(n, factors)
     counts = n_differences(n, factors, type)
@@ -169,3 +184,31 @@ def allan_variance_table(
         results[name] = AllanVariance(levels=levels, averaging_factors=factors, allan=allan[j], errors=errors,
                                       n_differences=counts, type=type, freq=freq, n=n, name=name, **extra)
     return results
+
+
+def _is_dask_array(x: Any) -> bool:
+    dask_array = sys.modules.get("dask.array")  # not loaded: x cannot be a Dask array
+    return dask_array is not None and isinstance(x, dask_array.Array)
+
+
+def _dask_allan_variance(x: Any, freq: Any, type: str, taus: Any, band: tuple, nan_policy: str) -> AllanVariance:
+    """A 1-D Dask array, chunk by chunk on the active scheduler (:mod:`avar.stability.dask_backend`)."""
+    from avar.stability.dask_backend import allan_variance_dask
+
+    if band[0] != "r" or nan_policy != "raise":
+        raise ValueError("a Dask array takes ci='r' and nan_policy='raise' (noise identification and gaps need "
+                         "the series in memory); compute it first, e.g. avar.avar(x.compute(), ci='chi2')")
+    if x.ndim != 1:
+        raise ValueError(f"x must be 1-D, got a Dask array of shape {x.shape}")
+    check_numeric_dtype(np.empty(0, dtype=x.dtype), "x")
+    check_length(int(x.shape[0]), "x")
+    rate = 1.0 if freq is None else check_freq(freq)
+
+    def checked(data: Any, factors: np.ndarray, type: str) -> np.ndarray:
+        allan = allan_variance_dask(data, factors, type)
+        if not np.isfinite(allan).all():  # a non-finite sample makes every level it touches non-finite
+            raise ValueError("x (a Dask array) holds NaN or infinite values; fill or cut them, "
+                             "or compute it and use nan_policy='omit'")
+        return allan
+
+    return allan_variance_table(x[:, None], (None,), rate, type, taus, band, columns=checked)[None]
