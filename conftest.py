@@ -1,14 +1,30 @@
 """Test configuration (doctests in src/ and tests/ alike).
 
 Plots render headless. Nothing here reaches outside the repository: the data sets ship
-inside the package.
+inside the package. A bare ``pytest`` in an environment without the package's
+dependencies stops at once with the command that installs them, instead of
+one import error per test module.
 """
 
+import importlib.util
 import os
 import sys
 from pathlib import Path
+
+import pytest
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 # Shared test helpers (tests/reference.py) import as top-level modules.
 sys.path.insert(0, str(Path(__file__).resolve().parent / "tests"))
+
+#: What ``pip install ".[test]"`` brings that every test module needs (import name: package).
+REQUIRED = {"numpy": "numpy", "scipy": "scipy", "pandas": "pandas", "matplotlib": "matplotlib",
+            "numba": "numba", "yaml": "pyyaml", "tqdm": "tqdm", "avar": "avar"}
+
+
+def pytest_configure(config):
+    missing = [package for module, package in REQUIRED.items() if importlib.util.find_spec(module) is None]
+    if missing:
+        pytest.exit(f"this Python ({sys.executable}) lacks {', '.join(missing)}; run the README's test command, "
+                    f"pip install \".[test]\" && pytest", returncode=4)
