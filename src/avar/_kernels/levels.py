@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from avar._kernels.streaming import fill_prefix, point, squares
+from avar._kernels.streaming import fill_prefix, point, squares, window_level_sums
 
 
 @njit(cache=True)
@@ -48,23 +48,9 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
         t0 = kb * block
         if t0 >= nd[0]:
             break
-        need = min(n, t0 + block + 2 * near)
-        if need - w0 > near_len:  # slide the window to start at t0
-            shift = t0 - w0
-            for i in range(filled + 1 - shift):
-                nh[i] = nh[i + shift]
-                nl[i] = nl[i + shift]
-            w0 = t0
-            filled -= shift
-        if w0 + filled < need:
-            fill_prefix(data, col, w0 + filled, need, centre, scale, nh[filled], nl[filled], nh, nl, filled)
-            filled = need - w0
+        w0, filled = window_level_sums(data, col, t0, min(n, t0 + block + 2 * near), centre, scale, nh, nl, w0,
+                                       filled, factors, nd, small_count, block, out_row, buffer)
         a = t0 - w0
-        for k in range(small_count):
-            cnt = min(block, nd[k] - t0)
-            if cnt > 0:
-                m = factors[k]
-                out_row[k] += squares(nh, nl, a, nh, nl, a + m, nh, nl, a + 2 * m, cnt, buffer)
         for k in range(small_count, n_levels):
             cnt = min(block, nd[k] - t0)
             if cnt <= 0:

@@ -248,3 +248,31 @@ def squares(h0, l0, a0, h1, l1, a1, h2, l2, a2, count, buffer):
         d = ((x2[j] - x1[j]) - (x1[j] - x0[j])) + ((y2[j] - y1[j]) - (y1[j] - y0[j]))
         buffer[j] = d * d
     return _fast_sum(buffer, count)
+
+
+@njit(cache=True)
+def window_level_sums(data, col, t0, need, centre, scale, wh, wl, w0, filled, factors, nd, count, block, out_row,
+                      buffer):
+    """Squared second differences of the first ``count`` levels for the block at ``t0``, from a sliding window.
+
+    The window holds the compensated prefix sums ``S[w0 .. w0 + filled]`` in ``wh``/``wl``; it slides to
+    start at ``t0`` when ``need`` would overrun its length and is filled up to ``need``. Adds into
+    ``out_row[:count]`` and returns the new ``(w0, filled)``.
+    """
+    if need - w0 >= wh.shape[0]:
+        shift = t0 - w0
+        for i in range(filled + 1 - shift):
+            wh[i] = wh[i + shift]
+            wl[i] = wl[i + shift]
+        w0 = t0
+        filled -= shift
+    if w0 + filled < need:
+        fill_prefix(data, col, w0 + filled, need, centre, scale, wh[filled], wl[filled], wh, wl, filled)
+        filled = need - w0
+    a = t0 - w0
+    for k in range(count):
+        cnt = min(block, nd[k] - t0)
+        if cnt > 0:
+            m = factors[k]
+            out_row[k] += squares(wh, wl, a, wh, wl, a + m, wh, wl, a + 2 * m, cnt, buffer)
+    return w0, filled

@@ -32,7 +32,7 @@ from numba import njit, prange, types
 from numba.extending import overload
 
 from avar._kernels.haar import _pair
-from avar._kernels.streaming import _fast_sum, _two_sum, fill_prefix, squares
+from avar._kernels.streaming import _fast_sum, _two_sum, window_level_sums
 
 #: Samples per block (region alignment, table granularity).
 SWEEP_BLOCK = 1 << 13
@@ -134,23 +134,8 @@ def sweep_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, n_small,
         if t0 >= nd[0]:
             break
         if n_small > 0:
-            need = min(n, t0 + block + halo)
-            if need - w0 >= cap:  # slide the window to start at t0
-                shift = t0 - w0
-                for i in range(filled + 1 - shift):
-                    wh[i] = wh[i + shift]
-                    wl[i] = wl[i + shift]
-                w0 = t0
-                filled -= shift
-            if w0 + filled < need:
-                fill_prefix(data, col, w0 + filled, need, centre, scale, wh[filled], wl[filled], wh, wl, filled)
-                filled = need - w0
-            a = t0 - w0
-            for k in range(n_small):
-                cnt = min(block, nd[k] - t0)
-                if cnt > 0:
-                    m = factors[k]
-                    out_row[k] += squares(wh, wl, a, wh, wl, a + m, wh, wl, a + 2 * m, cnt, buffer)
+            w0, filled = window_level_sums(data, col, t0, min(n, t0 + block + halo), centre, scale, wh, wl, w0,
+                                           filled, factors, nd, n_small, block, out_row, buffer)
         if n_small == n_levels or nd[n_small] <= t0:
             continue
         # large levels: region 0 (this block), then the m and 2m regions level by level

@@ -34,9 +34,9 @@ import pandas as pd
 from avar._kernels.deviation_phase import scan
 from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, short_repr
 from avar.stability.deviation_core import deviation_levels_and_phase
-from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors, term_counts
+from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors
 from avar.stability.deviation_results import Deviation
-from avar.stability.edf import chi2_bounds, estimator_edf
+from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.noise_id import NOISE_ID_ESTIMATORS, identify_noise, phase_noise
 
 DATA_TYPES = ("freq", "phase")
@@ -173,8 +173,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         alpha = _shared_phase_noise(estimator, phase, drift, factors)
     edf = estimator_edf(estimator, alpha, factors, n_phase)
     if n_missing:
-        # fewer terms, fewer degrees of freedom; but never below one (a single Gaussian term)
-        edf = np.maximum(edf * n / term_counts(estimator, n_phase, factors), 1.0)
+        edf = gap_scaled_edf(edf, n, estimator, n_phase, factors)
     lci, uci = chi2_bounds(deviation, edf, float(confidence))
     return Deviation(
         taus=factors / rate, averaging_factors=factors, deviation=deviation, variance=variance, n=n,

@@ -282,6 +282,17 @@ def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phas
     return greenhall_edf(alpha, d, factors, n_phase, overlapping=overlapping, modified=modified)
 
 
+def gap_scaled_edf(edf: np.ndarray, used: np.ndarray, estimator: str, n_phase: int, factors: np.ndarray) -> np.ndarray:
+    """EDF of levels that lost terms to gaps: scaled by the fraction of terms used, never below 1.
+
+    ``used`` terms of the gap-free count (:func:`avar.stability.deviation_grids.term_counts`)
+    remain at each level; one Gaussian term is one degree of freedom, the floor.
+    """
+    from avar.stability.deviation_grids import term_counts
+
+    return np.maximum(edf * used / term_counts(estimator, n_phase, factors), 1.0)
+
+
 def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE) -> tuple[np.ndarray, np.ndarray]:
     """Chi-squared confidence bounds of a deviation with ``edf`` degrees of freedom.
 

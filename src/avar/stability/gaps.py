@@ -16,9 +16,8 @@ import numpy as np
 
 from avar._validation import as_series, short_repr
 from avar.stability.deviation_core import deviation_levels
-from avar.stability.deviation_grids import term_counts
 from avar.stability.deviations import noise_exponents
-from avar.stability.edf import chi2_bounds, estimator_edf
+from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.grids import averaging_factors
 from avar.stability.intervals import relative_errors
 from avar.stability.results import AllanVariance
@@ -81,8 +80,7 @@ def allan_variance_with_gaps(values: np.ndarray, freq: float, type: str, taus: A
     ci, confidence = band
     if ci == "chi2":
         alpha = noise_exponents(estimator, values, "freq", freq, factors)
-        edf = estimator_edf(estimator, alpha, factors, n + 1) * counts / term_counts(estimator, n + 1, factors)
-        edf = np.maximum(edf, 1.0)  # never below one degree of freedom (a single Gaussian term)
+        edf = gap_scaled_edf(estimator_edf(estimator, alpha, factors, n + 1), counts, estimator, n + 1, factors)
         lci, uci = chi2_bounds(np.sqrt(allan), edf, confidence)
         extra = dict(ci=ci, confidence=confidence, alpha=alpha, edf=edf, chi2_lci=lci, chi2_uci=uci)
     return AllanVariance(levels=factors / freq, averaging_factors=factors, allan=allan,
