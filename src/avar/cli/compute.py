@@ -1,4 +1,9 @@
-"""``avar compute``: the Allan variance of the columns of a file."""
+"""``avar compute``: the Allan variance of the columns of a file (or of several: :mod:`avar.cli.compute_many`).
+
+``summary_of``, ``figure_of``, ``ReadOptions``, ``load`` and ``allan_of`` live in
+:mod:`avar.cli.compute_many` (the one path of reading and computing, for one file or
+many, on a worker of a cluster or here) and are re-exported here.
+"""
 
 from __future__ import annotations
 
@@ -6,47 +11,29 @@ import argparse
 import sys
 import threading
 from contextlib import contextmanager
-from pathlib import Path
 
-import pandas as pd
-
-from avar.cli.common import Progress, UsageError, format_table
+from avar.cli.common import Progress, format_table
+from avar.cli.compute_many import (
+    ReadOptions,
+    add_cluster_arguments,
+    allan_of,
+    figure_of,
+    load,
+    run_many,
+    summary_of,
+)
 from avar.cli.outputs import plan_outputs, report
 from avar.io.progress import PROGRESS_VALUES
+
+__all__ = ["ReadOptions", "add_input_arguments", "add_parser", "allan_of", "compute_from_args", "figure_of", "load",
+           "read_from_args", "run", "summary_of"]
 
 
 def read_from_args(args: argparse.Namespace):
     """The file named in ``args`` as a Recording or an IMU (``--gyro``/``--accel``, or a bag)."""
-    from avar.io.read import read
-
-    if args.column and (args.gyro or args.accel):
-        raise UsageError(
-            "--column cannot be combined with --gyro/--accel: --gyro and --accel name the IMU's columns "
-            "(use them alone, or --column alone for separate series)"
-        )
-    imu_columns = (args.gyro or []) + (args.accel or [])
-    data = read(
-        args.file,
-        columns=args.column or imu_columns or None,
-        freq=args.freq,
-        time_unit=args.time_unit,
-        gaps=args.gaps,
-        topic=args.topic,
-    )
-    from avar.imu import IMU
-
-    if isinstance(data, IMU):  # a bag
-        print(f"{args.file}: {data.describe()}", file=sys.stderr)
-        return data
-    note = data.describe().replace("(given)", "(--freq)")
-    if data.time_column is None and args.freq is None:
-        note += "; pass --freq for seconds"
-    print(note, file=sys.stderr)
-    if data.gaps_ignored:
-        print(f"{args.file}: --gaps ignore: the samples are treated as contiguous across the gaps", file=sys.stderr)
-    if imu_columns:
-        frame = pd.DataFrame(dict(data.columns), copy=False)
-        return IMU(frame, data.freq, gyro=args.gyro, accel=args.accel, name=Path(args.file).stem)
+    data, notes = load(args.file, ReadOptions.from_args(args))
+    for note in notes:
+        print(note, file=sys.stderr)
     return data
 
 
@@ -73,20 +60,19 @@ def compute_from_args(args: argparse.Namespace, progress: Progress):
     finally:
         warm_up.join()
     from avar.imu import IMU
-    from avar.stability.allan import avar
 
     progress("computing")
     values = data.data.size if isinstance(data, IMU) else len(data.columns) * data.n
     show = values > PROGRESS_VALUES and sys.stderr.isatty()
     if isinstance(data, IMU):  # one pass of the kernels over every channel: a clock, not a count
         with _elapsed(f"computing {len(data.channels)} channels", show):
-            return avar(data, type=args.type, taus=args.taus)
+            return allan_of(data, args.type, args.taus)
     names = list(data.columns)
     if show:
         from tqdm import tqdm
 
         names = tqdm(names, desc="computing", unit="column", file=sys.stderr, leave=False)
-    return {name: avar(data.columns[name], type=args.type, freq=data.freq, taus=args.taus) for name in names}
+    return allan_of(data, args.type, args.taus, names)
 
 
 @contextmanager
@@ -114,27 +100,10 @@ def _elapsed(description: str, enabled: bool):
         bar.close()
 
 
-def summary_of(results) -> pd.DataFrame:
-    """One flat summary table: a Scale column (1-based), and Channel when there are several."""
-    if isinstance(results, dict):
-        if len(results) == 1:
-            return next(iter(results.values())).summary().reset_index()
-        frames = {name: res.summary() for name, res in results.items()}
-        return pd.concat(frames, names=["Channel", "Scale"]).reset_index()
-    return results.summary().reset_index()
-
-
-def figure_of(results):
-    from avar.plotting.compare import plot_compare
-
-    if isinstance(results, dict):
-        if len(results) == 1:
-            return next(iter(results.values())).plot()
-        return plot_compare(list(results.values()), labels=list(results))
-    return results.plot()
-
-
 def run(args: argparse.Namespace) -> int:
+    if len(args.file) > 1 or args.workers is not None or args.scheduler is not None:
+        return run_many(args)
+    args = argparse.Namespace(**{**vars(args), "file": args.file[0]})
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
     progress = Progress()
     results = compute_from_args(args, progress)
@@ -145,10 +114,14 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_input_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "file", help="CSV/TSV/text, .npy, or a ROS bag (.bag, .db3, .mcap; needs avar[ros]); see docs/reading.md"
-    )
+def add_input_arguments(parser: argparse.ArgumentParser, many: bool = False) -> None:
+    """The reading and output options; ``many``: one or more files (``avar compute``)."""
+    what = "CSV/TSV/text, .npy, or a ROS bag (.bag, .db3, .mcap; needs avar[ros]); see docs/reading.md"
+    if many:
+        parser.add_argument("file", nargs="+",
+                            help=f"{what}; several files give one table with a File column")
+    else:
+        parser.add_argument("file", help=what)
     parser.add_argument(
         "--column", action="append", metavar="NAME", help="column to use (repeatable; default: all but time columns)"
     )
@@ -175,8 +148,8 @@ def add_input_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--force", action="store_true", help="replace existing --output / --plot files")
 
 
-
 def add_parser(commands) -> None:
-    compute = commands.add_parser("compute", help="Allan variance of the columns of a file")
-    add_input_arguments(compute)
+    compute = commands.add_parser("compute", help="Allan variance of the columns of one or more files")
+    add_input_arguments(compute, many=True)
+    add_cluster_arguments(compute)
     compute.set_defaults(handler=run)

@@ -8,7 +8,9 @@
   in a fixed order, so the result does not depend on the scheduler or on
   which worker ran what.
 * :func:`allan_variance_files`: many independent series (files) on a
-  ``dask.distributed`` cluster, with a progress bar on a terminal.
+  ``dask.distributed`` cluster, with a progress bar on a terminal; built on
+  :func:`map_on_cluster` (any picklable function of each file, one task per
+  file: what ``avar compute FILE... --workers N`` runs).
 
 Dask is imported inside the functions: this module imports without it.
 """
@@ -16,7 +18,8 @@ Dask is imported inside the functions: this module imports without it.
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -109,34 +112,67 @@ def allan_variance_files(
     (``progress`` forces it on or off). Returns ``(factors, allan (C, L))`` per
     path, in the order of ``paths``.
     """
-    from dask.distributed import Client, LocalCluster, as_completed
+    return map_on_cluster(_one_file, paths, reader, factors_fn, type, scheduler=scheduler, workers=workers,
+                          progress=progress, unit="series")
 
-    paths = list(paths)
-    own_cluster = None
+
+@contextmanager
+def cluster_client(scheduler: Any = None, workers: int = 2, timeout: float | None = None) -> Iterator[Any]:
+    """A ``distributed.Client``: ``scheduler`` itself (a Client, left open), one connected to an address
+    (closed afterwards), or one of a new ``LocalCluster`` of ``workers`` single-threaded worker
+    processes (both closed afterwards). ``timeout``: seconds to wait for a scheduler at an address."""
+    from dask.distributed import Client, LocalCluster
+
     if scheduler is None:
-        own_cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
-        client = Client(own_cluster)
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+            with Client(cluster) as client:
+                yield client
     elif isinstance(scheduler, str):
-        client = Client(scheduler)
+        options = {} if timeout is None else {"timeout": timeout}
+        with Client(scheduler, **options) as client:
+            yield client
     else:
-        client = scheduler
+        yield scheduler
+
+
+def map_on_cluster(
+    function: Callable[..., Any],
+    items: Iterable[Any],
+    *args: Any,
+    scheduler: Any = None,
+    workers: int = 2,
+    progress: bool | None = None,
+    unit: str = "file",
+    timeout: float | None = None,
+) -> list[Any]:
+    """``[function(item, *args) for item in items]``, one task per item on a ``dask.distributed`` cluster.
+
+    ``function`` must be picklable (a module-level function) and should return a small
+    result: every result travels back to this process. ``scheduler`` and ``workers`` as in
+    :func:`allan_variance_files` (``timeout``: see :func:`cluster_client`). The results come
+    back in the order of ``items``; the first task to fail raises its error here, and the
+    remaining tasks are cancelled. A tqdm bar counts finished tasks on stderr when it is a
+    terminal (``progress`` forces it on or off).
+    """
+    from dask.distributed import as_completed
+
+    items = list(items)
     show = sys.stderr.isatty() if progress is None else progress
-    try:
-        futures = [client.submit(_one_file, p, reader, factors_fn, type, pure=False) for p in paths]
+    with cluster_client(scheduler, workers, timeout) as client:
+        futures = [client.submit(function, item, *args, pure=False) for item in items]
         bar = None
         if show:
             from tqdm import tqdm
 
-            bar = tqdm(total=len(futures), file=sys.stderr, unit="series")
-        for _ in as_completed(futures):
+            bar = tqdm(total=len(futures), desc="computing", file=sys.stderr, unit=unit)
+        try:
+            for future in as_completed(futures):
+                if future.status == "error":
+                    future.result()  # raises the task's error
+                if bar is not None:
+                    bar.update(1)
+            return client.gather(futures)
+        finally:
             if bar is not None:
-                bar.update(1)
-        if bar is not None:
-            bar.close()
-        return client.gather(futures)
-    finally:
-        if own_cluster is not None:
-            client.close()
-            own_cluster.close()
-        elif isinstance(scheduler, str):
-            client.close()
+                bar.close()
+            client.cancel([future for future in futures if not future.done()])

@@ -1,0 +1,304 @@
+"""``avar compute FILE... [--workers N | --scheduler ADDRESS]``: many files, serially or on a cluster.
+
+This module also holds the one path of reading and computing a file that
+``avar compute FILE`` (:mod:`avar.cli.compute`, which imports it) uses: :func:`load`
+and :func:`allan_of`, with the tables and figures of a result. Every file is read
+and computed by :func:`compute_file`, the same reader and the same estimator.
+Without ``--workers``/``--scheduler`` the files run one after the other in this
+process; with them, one task per file on a
+``dask.distributed`` cluster (:func:`avar.stability.dask_backend.map_on_cluster`): a
+``LocalCluster`` of N single-threaded worker processes, or the scheduler at ADDRESS.
+A worker sends back only the small result of its file (per channel: taus, cluster
+sizes, Allan variances, errors and terms per level, name), from which this process
+rebuilds the very result objects the serial run builds, so the tables are equal.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import re
+import sys
+from collections.abc import Iterable
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from avar.cli.common import Progress, UsageError, format_table
+from avar.cli.outputs import plan_outputs, report
+
+__all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "compute_file", "compute_files",
+           "figure_of", "load", "run_many", "summary_of"]
+
+#: The progress bar over the files: None shows it when stderr is a terminal; True/False force it.
+SHOW_PROGRESS: bool | None = None
+#: Seconds to wait for the scheduler named by ``--scheduler``.
+CONNECT_TIMEOUT = 15.0
+ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+]*://)?(?:\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):\d{1,5}$")
+DASK_MISSING = '--workers/--scheduler run on dask.distributed, which is not installed: pip install "avar[dask]"'
+
+
+def positive_int(text: str) -> int:
+    """``--workers``: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number of worker processes >= 1, got {text!r}")
+    return value
+
+
+def scheduler_address(text: str) -> str:
+    """``--scheduler``: a dask.distributed scheduler address such as ``tcp://10.0.0.5:8786``."""
+    if not ADDRESS.match(text.strip()):
+        raise argparse.ArgumentTypeError(
+            f"expected a dask.distributed scheduler address such as tcp://10.0.0.5:8786, got {text!r}")
+    return text.strip()
+
+
+def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--workers", type=positive_int, metavar="N", default=None,
+                        help="compute the files in parallel on a local dask cluster of N worker processes "
+                             "(needs avar[dask])")
+    parser.add_argument("--scheduler", type=scheduler_address, metavar="ADDRESS", default=None,
+                        help="compute the files on the dask.distributed scheduler at ADDRESS, "
+                             "e.g. tcp://10.0.0.5:8786 (needs avar[dask])")
+
+
+# ----------------------------------------------------------------------------- one file, anywhere
+@dataclass(frozen=True)
+class ReadOptions:
+    """How to read a file and which Allan variance to compute: picklable, for the workers of a cluster."""
+
+    column: tuple[str, ...] = ()
+    freq: float | None = None
+    time_unit: str | None = None
+    gaps: str = "error"
+    topic: str | None = None
+    gyro: tuple[str, ...] = ()
+    accel: tuple[str, ...] = ()
+    type: str = "mo"
+    taus: str = "octave"
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> ReadOptions:
+        if args.column and (args.gyro or args.accel):
+            raise UsageError(
+                "--column cannot be combined with --gyro/--accel: --gyro and --accel name the IMU's columns "
+                "(use them alone, or --column alone for separate series)"
+            )
+        return cls(tuple(args.column or ()), args.freq, args.time_unit, args.gaps, args.topic,
+                   tuple(args.gyro or ()), tuple(args.accel or ()), args.type, args.taus)
+
+
+def load(path: str, options: ReadOptions, progress: bool | None = None) -> tuple[Any, list[str]]:
+    """The file as a Recording or an IMU (``--gyro``/``--accel``, or a bag), and the notes for stderr."""
+    from avar.imu import IMU
+    from avar.io.read import read
+
+    imu_columns = list(options.gyro + options.accel)
+    data = read(
+        path,
+        columns=list(options.column) or imu_columns or None,
+        freq=options.freq,
+        time_unit=options.time_unit,
+        gaps=options.gaps,
+        topic=options.topic,
+        progress=progress,
+    )
+    if isinstance(data, IMU):  # a bag
+        return data, [f"{path}: {data.describe()}"]
+    note = data.describe().replace("(given)", "(--freq)")
+    if data.time_column is None and options.freq is None:
+        note += "; pass --freq for seconds"
+    notes = [note]
+    if data.gaps_ignored:
+        notes.append(f"{path}: --gaps ignore: the samples are treated as contiguous across the gaps")
+    if imu_columns:
+        frame = pd.DataFrame(dict(data.columns), copy=False)
+        imu = IMU(frame, data.freq, gyro=list(options.gyro) or None, accel=list(options.accel) or None,
+                  name=Path(path).stem)
+        return imu, notes
+    return data, notes
+
+
+def allan_of(data: Any, type: str, taus: str, names: Iterable[str] | None = None):
+    """The Allan variance of an IMU, or of every column of a Recording (a dict by column name)."""
+    from avar.imu import IMU
+    from avar.stability.allan import avar
+
+    if isinstance(data, IMU):
+        return avar(data, type=type, taus=taus)
+    names = data.columns if names is None else names
+    return {name: avar(data.columns[name], type=type, freq=data.freq, taus=taus) for name in names}
+
+
+def summary_of(results) -> pd.DataFrame:
+    """One flat summary table: a Scale column (1-based), and Channel when there are several."""
+    if isinstance(results, dict):
+        if len(results) == 1:
+            return next(iter(results.values())).summary().reset_index()
+        frames = {name: res.summary() for name, res in results.items()}
+        return pd.concat(frames, names=["Channel", "Scale"]).reset_index()
+    return results.summary().reset_index()
+
+
+def figure_of(results):
+    from avar.plotting.compare import plot_compare
+
+    if isinstance(results, dict):
+        if len(results) == 1:
+            return next(iter(results.values())).plot()
+        return plot_compare(list(results.values()), labels=list(results))
+    return results.plot()
+
+
+# ----------------------------------------------------------------------------- on a worker
+def _pack_series(av: Any) -> dict[str, Any]:
+    return {field.name: getattr(av, field.name) for field in fields(av)}
+
+
+def pack(results: Any) -> dict[str, Any]:
+    """The numbers of a result (a dict of AllanVariance, or an ImuAllanVariance) as plain, picklable data."""
+    if isinstance(results, dict):
+        return {"series": {name: _pack_series(av) for name, av in results.items()}}
+    imu = {field.name: getattr(results, field.name) for field in fields(results)}
+    imu["channels"] = {name: _pack_series(av) for name, av in results.channels.items()}
+    imu["units"] = dict(results.units)
+    return {"imu": imu}
+
+
+def unpack(packed: dict[str, Any]) -> Any:
+    """The result objects :func:`pack` was given, rebuilt (and validated) by their constructors."""
+    from avar.stability.results import AllanVariance, ImuAllanVariance
+
+    if "series" in packed:
+        return {name: AllanVariance(**values) for name, values in packed["series"].items()}
+    imu = dict(packed["imu"])
+    imu["channels"] = {name: AllanVariance(**values) for name, values in imu["channels"].items()}
+    return ImuAllanVariance(**imu)
+
+
+def compute_file(path: str, options: ReadOptions) -> tuple[dict[str, Any], tuple[str, ...]]:
+    """Read one file and compute its Allan variance(s): (the packed result, the reader's notes).
+
+    Runs on a worker of the cluster (a module-level function, so it pickles by name),
+    or in this process for a serial run.
+    """
+    data, notes = load(path, options, progress=False)
+    return pack(allan_of(data, options.type, options.taus)), tuple(notes)
+
+
+# ----------------------------------------------------------------------------- the driver
+def compute_files(
+    paths: list[str], options: ReadOptions, workers: int | None = None, scheduler: str | None = None,
+    progress: bool | None = None,
+) -> list[tuple[Any, tuple[str, ...]]]:
+    """(result, notes) of every file, in order: serially (neither ``workers`` nor ``scheduler``),
+    else on a dask.distributed cluster. A bar counts the files on stderr when ``progress``."""
+    if workers is None and scheduler is None:
+        items: Any = paths
+        if progress:
+            from tqdm import tqdm
+
+            items = tqdm(paths, desc="computing", unit="file", file=sys.stderr)
+        packed = [compute_file(path, options) for path in items]
+    else:
+        from avar.stability.dask_backend import map_on_cluster
+
+        packed = map_on_cluster(compute_file, paths, options, scheduler=scheduler, workers=workers or 1,
+                                progress=progress, unit="file", timeout=CONNECT_TIMEOUT)
+    return [(unpack(result), notes) for result, notes in packed]
+
+
+def file_labels(paths: list[str]) -> list[str]:
+    """The File column: the stems, else the file names, else the paths as given (whichever is unique)."""
+    for label in (lambda p: Path(p).stem, lambda p: Path(p).name, str):
+        labels = [label(path) for path in paths]
+        if len(set(labels)) == len(labels):
+            return labels
+    return list(paths)
+
+
+def _channel_table(results: Any) -> pd.DataFrame:
+    """A file's summary with a Channel column, whatever its number of channels."""
+    if isinstance(results, dict):
+        frames = {name: res.summary() for name, res in results.items()}
+        return pd.concat(frames, names=["Channel", "Scale"]).reset_index()
+    return results.summary().reset_index()
+
+
+def summary_of_files(labels: list[str], results: list[Any]) -> pd.DataFrame:
+    """One table: a File column in front of each file's summary (Channel when any file has several)."""
+    single = all(isinstance(res, dict) and len(res) == 1 for res in results)
+    frames = []
+    for label, res in zip(labels, results):
+        frame = summary_of(res) if single else _channel_table(res)
+        frame.insert(0, "File", label)
+        frames.append(frame)
+    return pd.concat(frames, ignore_index=True)
+
+
+def figure_of_files(labels: list[str], results: list[Any]):
+    """Every series of every file on one comparison figure."""
+    from avar.plotting.compare import plot_compare
+
+    curves, names = [], []
+    for label, res in zip(labels, results):
+        channels = res if isinstance(res, dict) else dict(res.channels)
+        for name, av in channels.items():
+            curves.append(av)
+            names.append(label if len(channels) == 1 else f"{label}: {name}")
+    return plot_compare(curves, labels=names)
+
+
+def _check_files(paths: list[str]) -> None:
+    from avar.io.read import check_path
+
+    seen: set[str] = set()
+    for path in paths:
+        check_path(path)  # InputFileError naming the file
+        key = str(Path(path).resolve())
+        if key in seen:
+            raise UsageError(f"{path} is given twice; give each file once")
+        seen.add(key)
+
+
+def run_many(args: argparse.Namespace) -> int:
+    """``avar compute`` with several files, or with --workers/--scheduler."""
+    options = ReadOptions.from_args(args)
+    if args.workers is not None and args.scheduler is not None:
+        raise UsageError("--workers starts a local cluster and --scheduler names a running one; give one of them")
+    on_cluster = args.workers is not None or args.scheduler is not None
+    if on_cluster and importlib.util.find_spec("distributed") is None:
+        raise UsageError(DASK_MISSING)
+    paths = [str(path) for path in args.file]
+    plan = plan_outputs(csv=args.output, figure=args.plot, inputs=paths, force=args.force)
+    _check_files(paths)
+    progress = Progress()
+    where = f"on {args.scheduler}" if args.scheduler else f"on {args.workers} local worker(s)"
+    progress(f"computing {len(paths)} file(s) {where if on_cluster else 'one after the other'}")
+    show = sys.stderr.isatty() if SHOW_PROGRESS is None else SHOW_PROGRESS
+    computed = compute_files(paths, options, args.workers, args.scheduler, show)
+    for _, notes in computed:
+        for note in notes:
+            print(note, file=sys.stderr)
+    results = [res for res, _ in computed]
+    if len(results) == 1:
+        summary = summary_of(results[0])
+
+        def figure():
+            return figure_of(results[0])
+    else:
+        labels = file_labels(paths)
+        summary = summary_of_files(labels, results)
+
+        def figure():
+            return figure_of_files(labels, results)
+    written = plan.write(csv=lambda: summary.to_csv(index=False), figure=figure)
+    progress("done")
+    report(written, format_table(summary))
+    return 0
