@@ -1,5 +1,6 @@
 """The Haar pyramid of ADEV and HDEV (octave factors, frequency data) against exact arithmetic
-and against the general kernels."""
+and against the general kernels; its noise-identification moments against a NumPy transcription
+and against the two-pass lag-1 kernel on the stored phase."""
 
 from __future__ import annotations
 
@@ -8,9 +9,17 @@ import pytest
 
 from avar._kernels.deviation_phase import scan
 from avar._kernels.deviations import level_sums
-from avar.stability.deviation_core import _octave_sums, detrended_phase_of, deviation_levels
+from avar._kernels.noise_id import ILL_CONDITIONED, lag1_alpha_decimated, lag1_alpha_from_moments
+from avar._kernels.pyramid import MOMENTS, SPLIT_MIN, TAIL, octave_moments
+from avar.stability.deviation_core import OctaveMoments, _octave_sums, detrended_phase_of, deviation_levels
 from avar.stability.deviation_grids import KERNEL_CODES, deviation_factors, term_ranges
+from avar.stability.noise_id import NOISE_ID_ESTIMATORS, octave_noise, phase_noise
 from tests.deviation_reference import exact_variance
+from tests.powerlaw import powerlaw_phase
+
+ORDER = {"adev": 1, "hdev": 2}
+#: Lengths on the one-thread path and on the two-stretch path (cut at levels 1 .. 6).
+LENGTHS = [3, 4, 5, 1000, 4097, 4 * SPLIT_MIN, 4 * SPLIT_MIN + 3, 300_001]
 
 
 def adversarial(seed: int) -> list[np.ndarray]:
@@ -33,17 +42,111 @@ def test_pyramid_is_exact(estimator):
             assert v == pytest.approx(float(expected), rel=1e-12)
 
 
+def test_two_stretches_are_exact_on_an_offset():
+    y = 1e9 + 1e-6 * np.random.default_rng(3).standard_normal(4 * SPLIT_MIN + 5)
+    for estimator in ("adev", "hdev"):
+        factors = deviation_factors(estimator, y.size + 1)[:9]
+        variance, _ = deviation_levels(estimator, y, factors, "freq")
+        for m, v in zip(factors, variance):
+            assert v == pytest.approx(float(exact_variance(estimator, y, int(m), "freq")[0]), rel=1e-12)
+
+
 @pytest.mark.parametrize("estimator", ["adev", "hdev"])
-@pytest.mark.parametrize("n", [3, 4, 5, 1000, 4097])
+@pytest.mark.parametrize("n", LENGTHS)
 def test_pyramid_equals_the_general_kernels(estimator, n):
     y = np.random.default_rng(n).standard_normal(n) + 3.0
     if n < 4 and estimator == "hdev":
         return
     factors = deviation_factors(estimator, n + 1)
-    sums, counts, scale, phase, _ = _octave_sums(estimator, y, factors, scan(y))
+    sums, counts, scale, moments, _ = _octave_sums(estimator, y, factors, scan(y))
     hi, lo, scale2, _, _ = detrended_phase_of(y, "freq", estimator)
     strides, first, last = term_ranges(estimator, n + 1, factors)
     general, general_counts = level_sums(hi, lo, KERNEL_CODES[estimator], factors, strides, first, last)
     np.testing.assert_array_equal(counts, general_counts)
     np.testing.assert_allclose(sums / scale**2, general / scale2**2, rtol=1e-12)
-    np.testing.assert_allclose(phase / scale, hi / scale2, rtol=1e-9, atol=1e-9 * np.abs(hi / scale2).max())
+    assert isinstance(moments, OctaveMoments)
+
+
+def numpy_moments(v: np.ndarray, levels: int) -> np.ndarray:
+    """The columns of MOMENTS by plain NumPy: cluster sums, their running sum and differences."""
+    rows = []
+    for level in range(levels):
+        m = 2**level
+        c = v[: v.size // m * m].reshape(-1, m).sum(axis=1)
+        z = np.concatenate(([0.0], np.cumsum(c)))
+        t = np.arange(z.size) - c.size / 2
+        d1, d2, d3 = np.diff(c), np.diff(c, 2), np.diff(c, 3)
+        rows.append([c.size, z.sum(), (t * z).sum(), (t * t * z).sum(), (z * z).sum(), (c * c).sum(),
+                     (d1**2).sum(), (d2**2).sum(), (d3**2).sum(), z[-1], c[0], c[-1], d1[0], d1[-1], d2[0], d2[-1]])
+    return np.array(rows)
+
+
+@pytest.mark.parametrize("n", [40, 1000, 4 * SPLIT_MIN + 3, 300_001])
+def test_moments_equal_a_numpy_transcription(n):
+    y = 5.0 + np.random.default_rng(n).standard_normal(n)
+    levels = max(1, int(np.log2(n)) - 3)
+    stats = np.zeros((levels, len(MOMENTS)))
+    tails = np.zeros((levels, TAIL))
+    octave_moments(y, 5.0, 0.0, 1.0, 2, levels, stats, tails)
+    want = numpy_moments(y - 5.0, levels)
+    scale = np.abs(want).max(axis=0, initial=0.0)
+    np.testing.assert_allclose(stats, want, rtol=1e-9, atol=1e-12 * scale.max())
+    for level in range(levels):  # the small levels hand back their clusters
+        count = n >> level
+        if count <= TAIL:
+            np.testing.assert_allclose(tails[level, :count], (y - 5.0)[: count << level].reshape(count, -1).sum(1))
+
+
+def series(alpha: int, seed: int, n: int, kind: int) -> np.ndarray:
+    y = np.diff(powerlaw_phase(n + 1, alpha, seed))
+    if kind == 1:
+        y = y + 1e6 * np.abs(y).max()  # an offset far above the noise
+    elif kind == 2:
+        y = y + 1e-3 * np.arange(n) * np.abs(y).max()  # a drift far above it
+    return y
+
+
+@pytest.mark.parametrize("estimator", ["adev", "hdev"])
+def test_moments_decide_as_the_two_pass_kernel(estimator):
+    """Every level the moments decide gets the two-pass kernel's alpha; where cancellation
+    took too many digits they say so (only ADEV under a strong drift, which it keeps)."""
+    dmax = NOISE_ID_ESTIMATORS[estimator]
+    decided = undecided = 0
+    for alpha in (2, 1, 0, -1, -2):
+        for seed in range(6):
+            for n, kind in ((1000, seed % 3), (20_000, seed % 3), (300_000, seed % 3 if seed < 3 else 0)):
+                y = series(alpha, seed, n, kind)
+                factors = deviation_factors(estimator, n + 1)
+                _, _, _, moments, _ = _octave_sums(estimator, y, factors, scan(y))
+                phase = moments.phase()
+                for level, m in enumerate(factors.tolist()):
+                    if n // m + 1 < 30:
+                        continue
+                    got = lag1_alpha_from_moments(moments.stats[level], dmax)
+                    if got == ILL_CONDITIONED:
+                        assert estimator == "adev" and kind == 2
+                        undecided += 1
+                        continue
+                    decided += 1
+                    assert got == lag1_alpha_decimated(phase, m, dmax), (alpha, seed, n, kind, m)
+    assert decided >= 600 and undecided < decided / 4
+
+
+@pytest.mark.parametrize("estimator", ["adev", "hdev"])
+@pytest.mark.parametrize("alpha", [2, 0, -2])
+def test_octave_noise_equals_the_phase_path(estimator, alpha):
+    """B1 from the tails, R(n) and ill-conditioned levels through the phase: the same alphas."""
+    for kind in (0, 2):
+        y = series(alpha, 11, 50_000, kind)
+        factors = deviation_factors(estimator, y.size + 1)
+        _, _, _, moments, drift = _octave_sums(estimator, y, factors, scan(y))
+        dmax = NOISE_ID_ESTIMATORS[estimator]
+        got = octave_noise(moments.stats, moments.tails, factors, dmax, drift, moments.phase)
+        want = phase_noise(moments.phase(), factors, dmax, drift, line_free=True)
+        np.testing.assert_array_equal(got, want)
+
+
+def test_constant_level_has_no_alpha():
+    stats = np.zeros((1, len(MOMENTS)))
+    stats[0, 0] = 100.0
+    assert np.isnan(lag1_alpha_from_moments(stats[0], 2))

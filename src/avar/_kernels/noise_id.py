@@ -168,3 +168,81 @@ def running_sum(x, drift, step, out):
             block += x[i] + drift * (i * (i - 1.0) / 2.0)
         total += block
         out[q + 1] = total
+
+
+#: :func:`lag1_alpha_from_moments` returns this when cancellation leaves too few digits.
+ILL_CONDITIONED = -99.0
+#: Largest ratio of a raw sum of squares to the residual one derived from it (about 6 of
+#: 16 digits lost) for which the moments decide; beyond, the two-pass kernel does.
+KAPPA_MAX = 1e6
+
+
+@njit(cache=True, nogil=True)
+def _order_stats(row, d):
+    """total, squares, first, last of the order-``d`` differences of the residual phase
+    (its least-squares quadratic removed), and the raw sum of squares ``squares`` was derived from,
+    from the moments of :mod:`avar._kernels.pyramid` (``row``: one level, see ``MOMENTS``)."""
+    c = row[0]
+    k = c + 1.0
+    half = c / 2.0
+    c2 = (k * k - 1.0) / 12.0
+    s0, s1, q0, v_squares, e1, e2 = row[1], row[2], row[4], row[5], row[6], row[7]
+    s2 = row[3] - c2 * s0  # sum (t^2 - c2) z
+    a0 = s0 / k
+    a1 = s1 / (k * (k * k - 1.0) / 12.0)
+    a2 = s2 / (k * (k * k - 1.0) * (k * k - 4.0) / 180.0) if k > 2.0 else 0.0
+    z_last, v_first, v_last = row[9], row[10], row[11]
+    if d == 0:  # r = z - q(t): orthogonal projections of z removed
+        squares = q0 - s0 * a0 - s1 * a1 - s2 * a2
+        q_first = a0 - a1 * half + a2 * (half * half - c2)
+        q_last = a0 + a1 * half + a2 * (half * half - c2)
+        return s0 - k * a0, squares, -q_first, z_last - q_last, q0
+    if d == 1:  # v_j - l_j, l_j = a1 + a2 u_j, u_j = 2 j - (C - 1): sum u = 0, sum u^2 = C (C^2 - 1) / 3,
+        # sum v = z_C, sum u v = (C + 1) z_C - 2 sum z (summation by parts)
+        u_v = (c + 1.0) * z_last - 2.0 * s0
+        squares = v_squares - 2.0 * (a1 * z_last + a2 * u_v) + c * a1 * a1 + a2 * a2 * c * (c * c - 1.0) / 3.0
+        return (z_last - c * a1, squares, v_first - (a1 - a2 * (c - 1.0)), v_last - (a1 + a2 * (c - 1.0)),
+                v_squares)
+    if d == 2:  # the first differences of v less 2 a2
+        rise = v_last - v_first
+        squares = e1 - 4.0 * a2 * rise + 4.0 * a2 * a2 * (c - 1.0)
+        return rise - 2.0 * a2 * (c - 1.0), squares, row[12] - 2.0 * a2, row[13] - 2.0 * a2, e1
+    if d == 3:  # the second differences of v: the quadratic is gone
+        return row[13] - row[12], e2, row[14], row[15], e2
+    return 0.0, row[8], 0.0, 0.0, row[8]  # d == 4: only its sum of squares is used
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _lost(raw, squares):
+    """True when ``squares``, derived from the raw sum ``raw`` by cancellation, kept too few digits."""
+    return raw != 0.0 and not (squares > 0.0 and raw <= KAPPA_MAX * squares)
+
+
+@njit(cache=True, nogil=True)
+def lag1_alpha_from_moments(row, dmax):
+    """:func:`lag1_alpha_decimated` of one level from its moments, without the phase.
+
+    The lag-1 sum of products of each order of differences w follows from sums
+    of squares: sum w_i w_{i+1} = (2 sum w^2 - w_first^2 - w_last^2 - sum (dw)^2) / 2.
+    Returns NaN for a constant series and :data:`ILL_CONDITIONED` when a sum it
+    needs lost more than log10(:data:`KAPPA_MAX`) digits to cancellation.
+    """
+    length = row[0] + 1.0
+    total, squares, first, last, raw = _order_stats(row, 0)
+    for d in range(dmax + 1):
+        n_total, n_squares, n_first, n_last, n_raw = _order_stats(row, d + 1)
+        if _lost(raw, squares) or _lost(n_raw, n_squares):
+            return ILL_CONDITIONED
+        mean = total / length
+        power = squares - total * mean
+        if not power > 0.0:
+            return np.nan
+        products = (2.0 * squares - first * first - last * last - n_squares) / 2.0
+        lag = products - mean * (2.0 * total - first - last) + (length - 1.0) * mean * mean
+        r1 = lag / power
+        rho = r1 / (1.0 + r1)
+        if rho < 0.25 or d >= dmax:
+            return 2.0 - np.round(2.0 * rho) - 2.0 * d
+        total, squares, first, last, raw = n_total, n_squares, n_first, n_last, n_raw
+        length -= 1.0
+    return np.nan

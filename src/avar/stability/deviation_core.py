@@ -5,19 +5,22 @@ variance and the number of terms of every level, through the kernels of
 :mod:`avar._kernels.deviations` (ADEV and HDEV of gap-free frequency data at
 the octave factors m = 1, 2, 4, ...: the Haar pyramid of
 :mod:`avar._kernels.pyramid`, one read of the data).
-:func:`deviation_levels_and_phase` also hands back the detrended phase it
-built, so that the public functions identify the noise on it without another
-pass over the data. It validates nothing: the public functions
-of :mod:`avar.stability.deviations` do, once.
+:func:`deviation_levels_and_phase` also hands back what the noise
+identification needs without another pass over the data: the detrended phase
+it built, or, from the pyramid, an :class:`OctaveMoments`. It validates
+nothing: the public functions of :mod:`avar.stability.deviations` do, once.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 
 from avar._kernels.deviation_phase import centred_moment
 from avar._kernels.deviations import detrended_phase, level_sums, scan
-from avar._kernels.pyramid import octave_sums
+from avar._kernels.pyramid import MOMENTS, SUM_COLUMN, TAIL, octave_moments
 from avar.stability.deviation_grids import KERNEL_CODES, term_counts, term_ranges
 
 #: Denominator constant of every estimator: sigma^2 = sum / (K m^2 tau0^2 n) (MDEV: K m^4 tau0^2 n).
@@ -65,18 +68,39 @@ def _scale(low: float, high: float, origin: float) -> float:
     return float(np.ldexp(1.0, -int(np.clip(exponent, -1000, 1000))))
 
 
+class OctaveMoments(NamedTuple):
+    """What the noise identification of the pyramid's levels needs (see :mod:`avar._kernels.pyramid`).
+
+    ``stats``: the moments of every level (columns ``MOMENTS``); ``tails``:
+    the cluster sums of the levels with at most ``TAIL`` clusters;
+    ``phase()``: builds the detrended phase (one O(N) pass), for the rare
+    level the moments cannot decide.
+    """
+
+    stats: np.ndarray
+    tails: np.ndarray
+    phase: Callable[[], np.ndarray]
+
+
 def _octave_sums(estimator: str, data: np.ndarray, factors: np.ndarray, scanned: tuple):
     """ADEV/HDEV of gap-free frequency data at m = 1, 2, 4, ... by the Haar pyramid
-    (:mod:`avar._kernels.pyramid`): ``sums, counts, scale, phase, drift``."""
+    (:mod:`avar._kernels.pyramid`): ``sums, counts, scale, moments, drift``."""
     _, total, low, high = scanned
     count = data.shape[0]
     slope = _drift(data, False) if estimator == "hdev" else 0.0
     centre = total / count - slope * (count - 1) / 2
     scale = _scale(low, high, centre)
-    sums = np.empty(factors.size)
-    phase = np.empty(count + 1)
-    octave_sums(data, float(centre), slope, scale, 1 if estimator == "adev" else 2, factors.size, sums, phase)
-    return sums, term_counts(estimator, count + 1, factors), scale, phase, slope * scale
+    stats = np.zeros((factors.size, len(MOMENTS)))
+    tails = np.zeros((factors.size, TAIL))
+    order = 1 if estimator == "adev" else 2
+    octave_moments(data, float(centre), slope, scale, order, factors.size, stats, tails)
+    sums = np.ascontiguousarray(stats[:, SUM_COLUMN[order]])
+
+    def phase() -> np.ndarray:
+        return phase_parts(data, "freq", estimator, scanned)[5]
+
+    moments = OctaveMoments(stats, tails, phase)
+    return sums, term_counts(estimator, count + 1, factors), scale, moments, slope * scale
 
 
 def _is_octave(factors: np.ndarray) -> bool:
@@ -166,10 +190,11 @@ def deviation_levels(
 
 def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str = "phase",
                                rate: float = 1.0, scanned: tuple | None = None):
-    """:func:`deviation_levels` and the detrended phase it used, for noise identification.
+    """:func:`deviation_levels` and what the noise identification needs.
 
-    Returns ``variance, n, phase, drift`` (``phase`` and ``drift`` as in
-    :func:`phase_parts`, the phase scaled by a power of two).
+    Returns ``variance, n, phase, drift``: ``phase`` the detrended phase it
+    used (scaled by a power of two, as in :func:`phase_parts`) or, on the
+    pyramid's path, an :class:`OctaveMoments`; ``drift`` as in :func:`phase_parts`.
     """
     factors = np.asarray(factors, dtype=np.int64)
     n_phase = data.shape[0] + (data_type == "freq")

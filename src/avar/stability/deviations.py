@@ -33,11 +33,11 @@ import pandas as pd
 
 from avar._kernels.deviation_phase import scan
 from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, short_repr
-from avar.stability.deviation_core import deviation_levels_and_phase
+from avar.stability.deviation_core import OctaveMoments, deviation_levels_and_phase
 from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors
 from avar.stability.deviation_results import Deviation
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
-from avar.stability.noise_id import NOISE_ID_ESTIMATORS, identify_noise, phase_noise
+from avar.stability.noise_id import NOISE_ID_ESTIMATORS, identify_noise, octave_noise, phase_noise
 
 DATA_TYPES = ("freq", "phase")
 NAN_POLICIES = ("raise", "omit")
@@ -137,8 +137,12 @@ def noise_exponents(estimator: str, values: np.ndarray, data_type: str, rate: fl
     return alpha
 
 
-def _shared_phase_noise(estimator: str, phase: np.ndarray, drift: float, factors: np.ndarray) -> np.ndarray:
-    """:func:`noise_exponents` of gap-free data from the detrended phase of the variances."""
+def _shared_phase_noise(estimator: str, phase: np.ndarray | OctaveMoments, drift: float,
+                        factors: np.ndarray) -> np.ndarray:
+    """:func:`noise_exponents` of gap-free data from the detrended phase of the variances,
+    or from the moments of the pyramid's levels."""
+    if isinstance(phase, OctaveMoments):
+        return octave_noise(phase.stats, phase.tails, factors, NOISE_ID_ESTIMATORS[estimator], drift, phase.phase)
     alpha = np.zeros(factors.size, dtype=np.int64)
     fits = factors < phase.size
     if phase.size >= 4 and fits.any():

@@ -8,6 +8,7 @@ fewer remain. Each level costs O(N / m) after one pass over the data.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -123,6 +124,44 @@ def phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float = 0.0, lin
     which see it, get it back. ``line_free``: ``x`` has no large line (its
     mean frequency was removed), so R(n)'s running sum needs no conditioning.
     """
+    return _fill(_raw_phase_noise(x, m, dmax, drift, line_free), m)
+
+
+def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int, drift: float,
+                 phase: Callable[[], np.ndarray]) -> np.ndarray:
+    """:func:`phase_noise` at the octave factors ``m`` = 1, 2, 4, ... from the pyramid's moments.
+
+    ``stats``, ``tails``: per level, the moments and the small levels'
+    cluster sums of :func:`avar._kernels.pyramid.octave_moments` (the phase
+    is never built for them); ``phase()`` builds the detrended phase, called
+    only for a level the moments cannot decide: one whose sums lost too many
+    digits to cancellation (a frequency drift far above the noise in ADEV),
+    or one where B1 says PM and R(n) must split white from flicker.
+    """
+    from avar._kernels.noise_id import ILL_CONDITIONED, lag1_alpha_from_moments
+
+    alpha = np.full(m.size, np.nan)
+    undecided = []
+    for i, factor in enumerate(m.tolist()):
+        count = int(stats[i, 0])
+        if count + 1 >= MIN_ACF_POINTS:
+            alpha[i] = lag1_alpha_from_moments(stats[i], dmax)
+            if alpha[i] == ILL_CONDITIONED:
+                undecided.append(i)
+        elif count >= MIN_B1_POINTS:
+            index = np.arange(count + 1) * factor
+            points = np.concatenate(([0.0], np.cumsum(tails[i, :count])))
+            alpha[i] = _b1_ratio_alpha(points + drift * _triangular(index.astype(np.float64)) if drift else points,
+                                       factor)
+            if np.isinf(alpha[i]):
+                undecided.append(i)
+    if undecided:
+        alpha[undecided] = _raw_phase_noise(phase(), m[undecided], dmax, drift, line_free=True)
+    return _fill(alpha, m)
+
+
+def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line_free: bool) -> np.ndarray:
+    """:func:`phase_noise` before the levels without an estimate are filled (NaN there)."""
     from avar._kernels.noise_id import lag1_levels, lag1_levels_split
 
     n = x.size
@@ -158,7 +197,7 @@ def phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float = 0.0, lin
             alpha[i] = _b1_ratio_alpha(points(np.arange(0, k * factor + 1, factor)), factor)
             if np.isinf(alpha[i]):  # PM: R(n) splits white from flicker
                 alpha[i] = _rn_alpha(points, n, running, factor)
-    return _fill(alpha, m)
+    return alpha
 
 
 def _triangular(k: np.ndarray) -> np.ndarray:
