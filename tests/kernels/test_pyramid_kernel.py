@@ -10,7 +10,7 @@ import pytest
 from avar._kernels.deviation_phase import scan
 from avar._kernels.deviations import level_sums
 from avar._kernels.noise_id import ILL_CONDITIONED, lag1_alpha_decimated, lag1_alpha_from_moments
-from avar._kernels.pyramid import MOMENTS, SPLIT_MIN, TAIL, octave_moments
+from avar._kernels.pyramid import BLOCK_EXP, MOMENTS, SPLIT_BLOCKS, TAIL, octave_moments
 from avar.stability.deviation_core import OctaveMoments, _octave_sums, detrended_phase_of, deviation_levels
 from avar.stability.deviation_grids import KERNEL_CODES, deviation_factors, term_ranges
 from avar.stability.noise_id import NOISE_ID_ESTIMATORS, octave_noise, phase_noise
@@ -18,8 +18,10 @@ from tests.deviation_reference import exact_variance
 from tests.powerlaw import powerlaw_phase
 
 ORDER = {"adev": 1, "hdev": 2}
-#: Lengths on the one-thread path and on the two-stretch path (cut at levels 1 .. 6).
-LENGTHS = [3, 4, 5, 1000, 4097, 4 * SPLIT_MIN, 4 * SPLIT_MIN + 3, 300_001]
+#: Shortest series cut in two stretches (one per thread).
+TWO = SPLIT_BLOCKS << BLOCK_EXP
+#: Lengths within one block, over several (the last partial), and in two stretches.
+LENGTHS = [3, 4, 5, 1000, 4097, TWO - 1, TWO, TWO + 3, 300_001]
 
 
 def adversarial(seed: int) -> list[np.ndarray]:
@@ -43,7 +45,7 @@ def test_pyramid_is_exact(estimator):
 
 
 def test_two_stretches_are_exact_on_an_offset():
-    y = 1e9 + 1e-6 * np.random.default_rng(3).standard_normal(4 * SPLIT_MIN + 5)
+    y = 1e9 + 1e-6 * np.random.default_rng(3).standard_normal(TWO + 5)
     for estimator in ("adev", "hdev"):
         factors = deviation_factors(estimator, y.size + 1)[:9]
         variance, _ = deviation_levels(estimator, y, factors, "freq")
@@ -81,7 +83,7 @@ def numpy_moments(v: np.ndarray, levels: int) -> np.ndarray:
     return np.array(rows)
 
 
-@pytest.mark.parametrize("n", [40, 1000, 4 * SPLIT_MIN + 3, 300_001])
+@pytest.mark.parametrize("n", [40, 1000, 3 << BLOCK_EXP, TWO + 3, 300_001])
 def test_moments_equal_a_numpy_transcription(n):
     y = 5.0 + np.random.default_rng(n).standard_normal(n)
     levels = max(1, int(np.log2(n)) - 3)

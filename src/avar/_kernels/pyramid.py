@@ -18,10 +18,18 @@ differences needs (:data:`MOMENTS`, read by
 :func:`avar._kernels.noise_id.lag1_alpha_from_moments`): the phase is never
 stored, and the noise identification costs no pass of its own. Levels with
 at most :data:`TAIL` clusters also hand back their cluster sums (Barnes's B1
-ratio needs the few decimated points). One thread, a fixed order: the result
-does not depend on the thread count. The tests compare it with the general
-kernels of :mod:`avar._kernels.deviations`, with exact arithmetic, and the
-noise identification with the plain two-pass kernel on the stored phase.
+ratio needs the few decimated points).
+
+The lower levels go block by block (2**:data:`BLOCK_EXP` samples): a block's
+pyramid lives in a buffer of half a block and each level carries its running
+state (:data:`STATE`) from block to block, so the workspace is a few
+kilobytes plus one value per block, never O(N) fresh memory (whose first-touch
+page faults cost more than the arithmetic). A long series runs as two
+stretches on two threads, cut at a block boundary fixed by N: the bits do not
+depend on the thread count. The tests compare the sums with the general
+kernels of :mod:`avar._kernels.deviations` and with exact arithmetic, the
+moments with a NumPy transcription, and the noise identification with the
+plain two-pass kernel on the stored phase.
 """
 
 from __future__ import annotations
@@ -45,32 +53,47 @@ TAIL = 32
 SUM_COLUMN = {1: 6, 2: 7}
 
 
+#: Per-level running state of one stretch (see :func:`_chunk`).
+STATE = 26
+_Z, _S0, _S1, _S2, _Q0, _VSQ, _E1, _E2, _E3 = 0, 1, 2, 3, 4, 5, 6, 7, 8  # running sums
+_PH, _PL, _PPH, _PPL, _P3H, _P3L = 9, 10, 11, 12, 13, 14  # the last three clusters (h, l)
+_PD1, _PD2, _D1F, _D2F, _T = 15, 16, 17, 18, 19  # last and first differences; centred index
+_F0 = 20  # the first three clusters: h, l at 20 .. 25
+
+#: Level-1 samples per block: the pyramid of a block lives in a small buffer (no O(N) workspace).
+BLOCK_EXP = 12
+#: A series of at least this many blocks runs as two stretches, one per thread.
+SPLIT_BLOCKS = 8
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _value(y, start, centre, slope, scale, src_hi, src_lo, first_level, j):
-    """Cluster j of a stretch: level 1's from ``y[start + j]``, the others' from ``src_hi/lo``."""
+    """Cluster j of a chunk: level 1's from ``y[start + j]``, the others' from ``src_hi/lo``."""
     if first_level:
         return _increment(y, _NO_LO, start + j, 0, centre, slope, scale)
     return src_hi[j], src_lo[j]
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _level_body(y, start, centre, slope, scale, src_hi, src_lo, first_level, order, count, k0, z0, half, dst_hi,
-                dst_lo, acc, ends):
-    """Add one stretch of a level to the moments ``acc`` (see :data:`MOMENTS`; the
-    stretch's clusters have the level indices ``k0 .. k0 + count - 1`` and the phase
-    before it is ``z0``) and write the pair sums of its clusters into
-    ``dst_hi/lo[: count // 2]`` (may alias ``src``: index j // 2 <= j). The sum of the
-    estimator's own ``order``-th differences is exact (double-double terms); the other
-    orders, for the noise identification only, are differences of those. ``ends``: the
-    first and last three clusters (h, l), for the seams."""
-    z = z0
-    s0 = s1 = s2 = q0 = v_squares = e1 = e2 = e3 = 0.0
-    ph = pl = pph = ppl = 0.0  # the previous two clusters
-    pd1 = pd2 = 0.0
-    d1_first = d1_last = d2_first = d2_last = 0.0
-    t = k0 + 1.0 - half  # the centred index of the phase point after cluster j
+def _chunk_body(y, start, centre, slope, scale, src_hi, src_lo, first_level, order, count, j0, state, dst_hi, dst_lo,
+                tail, k0):
+    """Carry one level of a stretch over its next ``count`` clusters (stretch indices ``j0 ..``).
+
+    ``state`` (:data:`STATE` values) holds the running moments, the last three
+    and the first three clusters. The sum of the estimator's own ``order``-th
+    differences is exact (double-double terms); the other orders, for the noise
+    identification only, are differences of those. The pair sums go to
+    ``dst_hi/lo[: count // 2]`` (``j0`` even; may alias ``src``: j // 2 <= j);
+    with a non-empty ``tail``, the clusters go to ``tail[k0 + j0 + j]``.
+    """
+    z, s0, s1, s2, q0 = state[_Z], state[_S0], state[_S1], state[_S2], state[_Q0]
+    v_squares, e1, e2, e3 = state[_VSQ], state[_E1], state[_E2], state[_E3]
+    ph, pl, pph, ppl, p3h, p3l = state[_PH], state[_PL], state[_PPH], state[_PPL], state[_P3H], state[_P3L]
+    pd1, pd2, d1_first, d2_first, t = state[_PD1], state[_PD2], state[_D1F], state[_D2F], state[_T]
+    keep = tail.shape[0] > 0
     for j in range(count):
         h, l = _value(y, start, centre, slope, scale, src_hi, src_lo, first_level, j)
+        jj = j0 + j
         v = h + l
         z += v
         s0 += z
@@ -79,22 +102,24 @@ def _level_body(y, start, centre, slope, scale, src_hi, src_lo, first_level, ord
         q0 += z * z
         v_squares += v * v
         t += 1.0
-        if j < 3:  # before the pairs overwrite them
-            ends[0, j] = h
-            ends[1, j] = l
-        if j >= 1:
+        if keep:
+            tail[k0 + jj] = v
+        if jj < 3:
+            state[_F0 + 2 * jj] = h
+            state[_F0 + 2 * jj + 1] = l
+        if jj >= 1:
             d1 = (h - ph) + (l - pl)
             e1 += d1 * d1
-            if j >= 2:
+            if jj >= 2:
                 if order == 1:
                     d2 = d1 - pd1
                 else:
                     d2 = ((h - ph) - (ph - pph)) + ((l - pl) - (pl - ppl))
-                    if j >= 3:
+                    if jj >= 3:
                         d3 = d2 - pd2
                         e3 += d3 * d3
                 e2 += d2 * d2
-                if j == 2:
+                if jj == 2:
                     d2_first = d2
                 pd2 = d2
             else:
@@ -104,54 +129,63 @@ def _level_body(y, start, centre, slope, scale, src_hi, src_lo, first_level, ord
             s, e = _two_sum(ph, h)
             dst_hi[j // 2] = s
             dst_lo[j // 2] = (pl + l) + e
-        pph, ppl, ph, pl = ph, pl, h, l
-    d1_last = pd1
-    d2_last = pd2
-    for j in range(max(0, count - 3), count):  # the last three (re-read; intact when count >= 6)
-        ends[0, 6 + j - count], ends[1, 6 + j - count] = _value(y, start, centre, slope, scale, src_hi, src_lo,
-                                                                first_level, j)
-    acc[0] += count
-    acc[1] += s0
-    acc[2] += s1
-    acc[3] += s2
-    acc[4] += q0
-    acc[5] += v_squares
-    acc[6] += e1
-    acc[7] += e2
-    acc[8] += e3
-    acc[9] = z
-    acc[11] = ph + pl
-    acc[13] = d1_last
-    acc[15] = d2_last
-    if k0 == 0:
-        acc[10] = ends[0, 0] + ends[1, 0]
-        acc[12] = d1_first
-        acc[14] = d2_first
+        p3h, p3l, pph, ppl, ph, pl = pph, ppl, ph, pl, h, l
+    state[_Z], state[_S0], state[_S1], state[_S2], state[_Q0] = z, s0, s1, s2, q0
+    state[_VSQ], state[_E1], state[_E2], state[_E3] = v_squares, e1, e2, e3
+    state[_PH], state[_PL], state[_PPH], state[_PPL], state[_P3H], state[_P3L] = ph, pl, pph, ppl, p3h, p3l
+    state[_PD1], state[_PD2], state[_D1F], state[_D2F], state[_T] = pd1, pd2, d1_first, d2_first, t
 
 
 @njit(cache=True, nogil=True)
-def _first_level(y, start, centre, slope, scale, order, count, k0, z0, half, dst_hi, dst_lo, acc, ends):
-    """:func:`_level_body` of level 1 (the values from ``y``)."""
-    _level_body(y, start, centre, slope, scale, dst_hi, dst_lo, True, order, count, k0, z0, half, dst_hi, dst_lo, acc,
-                ends)
+def _first_chunk(y, start, centre, slope, scale, order, count, j0, state, dst_hi, dst_lo, tail, k0):
+    """:func:`_chunk_body` of level 1 (the values from ``y[start:]``)."""
+    _chunk_body(y, start, centre, slope, scale, dst_hi, dst_lo, True, order, count, j0, state, dst_hi, dst_lo, tail,
+                k0)
 
 
 @njit(cache=True, nogil=True)
-def _upper_level(src_hi, src_lo, order, count, k0, z0, half, dst_hi, dst_lo, acc, ends):
-    """:func:`_level_body` of a level from the cluster sums ``src_hi/lo``."""
-    _level_body(src_hi, 0, 0.0, 0.0, 1.0, src_hi, src_lo, False, order, count, k0, z0, half, dst_hi, dst_lo, acc,
-                ends)
+def _upper_chunk(src_hi, src_lo, order, count, j0, state, dst_hi, dst_lo, tail, k0):
+    """:func:`_chunk_body` of a level from the cluster sums ``src_hi/lo``."""
+    _chunk_body(src_hi, 0, 0.0, 0.0, 1.0, src_hi, src_lo, False, order, count, j0, state, dst_hi, dst_lo, tail, k0)
 
 
 @njit(cache=True, nogil=True)
-def _seam(left, right, order, acc):
-    """Add to ``acc`` the squared differences that straddle the seam between two stretches
-    (``left``/``right``: their ``ends``; each stretch >= 3 clusters), as :func:`_level_body` forms them."""
-    h = np.empty(6)
-    l = np.empty(6)
-    for i in range(3):
-        h[i], l[i] = left[0, 3 + i], left[1, 3 + i]
-        h[3 + i], l[3 + i] = right[0, i], right[1, i]
+def _stretch(y, centre, slope, scale, order, first_block, stop_block, levels, states, top_hi, top_lo, tails,
+             block_exp):
+    """The lower ``levels`` levels (at most ``block_exp``) of the blocks ``first_block ..
+    stop_block - 1`` (the last may be partial), block by block: each block's pyramid in a
+    buffer of half a block, the per-level state carried from block to block; every full
+    block's level-``block_exp`` cluster sum goes to ``top_hi/lo[block]``."""
+    n = y.shape[0]
+    block = 1 << block_exp
+    buffer_hi = np.empty(block // 2)
+    buffer_lo = np.empty(block // 2)
+    no_tail = np.empty(0)
+    for b in range(first_block, stop_block):
+        count = min(block, n - b * block)
+        j0 = (b - first_block) * block
+        for level in range(levels):
+            tail = tails[level] if (n >> level) <= tails.shape[1] else no_tail
+            k0 = first_block << (block_exp - level)
+            if level == 0:
+                _first_chunk(y, b * block, centre, slope, scale, order, count, j0, states[0], buffer_hi, buffer_lo,
+                             tail, k0)
+            else:
+                _upper_chunk(buffer_hi, buffer_lo, order, count, j0, states[level], buffer_hi, buffer_lo, tail, k0)
+            count //= 2
+            j0 //= 2
+        if levels == block_exp and count == 1:
+            top_hi[b] = buffer_hi[0]
+            top_lo[b] = buffer_lo[0]
+
+
+@njit(cache=True, nogil=True)
+def _seam(left, right, order, row):
+    """Add to the moments ``row`` the squared differences that straddle the seam between two
+    stretches (``left``/``right``: their states, each stretch >= 3 clusters), as
+    :func:`_chunk_body` forms them."""
+    h = np.array([left[_P3H], left[_PPH], left[_PH], right[_F0], right[_F0 + 2], right[_F0 + 4]])
+    l = np.array([left[_P3L], left[_PPL], left[_PL], right[_F0 + 1], right[_F0 + 3], right[_F0 + 5]])
     d1 = np.zeros(6)
     d2 = np.zeros(6)
     for j in range(1, 6):
@@ -161,12 +195,30 @@ def _seam(left, right, order, acc):
                 d2[j] = d1[j] - d1[j - 1]
             else:
                 d2[j] = ((h[j] - h[j - 1]) - (h[j - 1] - h[j - 2])) + ((l[j] - l[j - 1]) - (l[j - 1] - l[j - 2]))
-    acc[6] += d1[3] * d1[3]
-    acc[7] += d2[3] * d2[3] + d2[4] * d2[4]
+    row[6] += d1[3] * d1[3]
+    row[7] += d2[3] * d2[3] + d2[4] * d2[4]
     if order == 2:
         for j in range(3, 6):
             d3 = d2[j] - d2[j - 1]
-            acc[8] += d3 * d3
+            row[8] += d3 * d3
+
+
+@njit(cache=True, nogil=True)
+def _start(state, count, k_first, z0):
+    """A fresh state for a stretch starting at cluster ``k_first`` of a level of ``count``, phase ``z0``."""
+    state[:] = 0.0
+    state[_Z] = z0
+    state[_T] = k_first + 1.0 - count / 2.0
+
+
+@njit(cache=True, nogil=True)
+def _moments_row(state, count, row):
+    """The :data:`MOMENTS` of a level from the state of its only (or left) stretch."""
+    row[0] = count
+    row[1], row[2], row[3], row[4], row[5] = state[_S0], state[_S1], state[_S2], state[_Q0], state[_VSQ]
+    row[6], row[7], row[8] = state[_E1], state[_E2], state[_E3]
+    row[9], row[10], row[11] = state[_Z], state[_F0] + state[_F0 + 1], state[_PH] + state[_PL]
+    row[12], row[13], row[14], row[15] = state[_D1F], state[_PD1], state[_D2F], state[_PD2]
 
 
 @njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
@@ -178,11 +230,6 @@ def _phase_at(y, centre, slope, scale, stop):
     return total * scale
 
 
-#: Series of at least this many samples are cut in two stretches, one per thread, for the
-#: levels that keep at least SPLIT_MIN clusters on each side.
-SPLIT_MIN = 1 << 12
-
-
 @njit(cache=True, nogil=True, parallel=True)
 def octave_moments(y, centre, slope, scale, order, n_levels, stats, tails):
     """Moments (``stats``, shape (L, len(MOMENTS))) and small levels' clusters (``tails``,
@@ -190,64 +237,49 @@ def octave_moments(y, centre, slope, scale, order, n_levels, stats, tails):
     sum of squares at each level is ``stats[:, SUM_COLUMN[order]]``.
 
     Level 1 holds ``(y_i - centre - slope i) scale`` (``slope i`` exact, ``scale`` a power of two).
-    The lower levels of a long series run as two stretches on two threads, cut at a
-    point that depends on N alone (the bits do not depend on the thread count).
+    The lower levels go block by block (:func:`_stretch`); a long series runs as two
+    stretches on two threads, cut at a block boundary that depends on N alone (the bits
+    do not depend on the thread count). The upper levels run on the blocks' sums.
     """
     n = y.shape[0]
-    split = 0  # levels computed as two stretches
-    while split < n_levels and (n >> (split + 1)) >= 2 * SPLIT_MIN:
-        split += 1
-    cut = ((n // 2) >> split) << split if split > 0 else n  # level-1 index where the right stretch starts
-    left_hi = np.empty(max(cut // 2, 1))
-    left_lo = np.empty(max(cut // 2, 1))
-    right_hi = np.empty(max((n - cut) // 2, 1))
-    right_lo = np.empty(max((n - cut) // 2, 1))
-    right_acc = np.zeros((max(split, 1), stats.shape[1]))
-    ends = np.zeros((2, max(split, 1), 2, 6))
-    z_cut = _phase_at(y, centre, slope, scale, cut) if split > 0 else 0.0
-    for side in prange(2 if split > 0 else 0):
-        for level in range(split):
-            count = n >> level
-            half = count / 2.0
-            k_cut = cut >> level
-            if side == 0:
-                if level == 0:
-                    _first_level(y, 0, centre, slope, scale, order, k_cut, 0, 0.0, half, left_hi, left_lo, stats[0],
-                                 ends[0, 0])
-                else:
-                    _upper_level(left_hi, left_lo, order, k_cut, 0, 0.0, half, left_hi, left_lo, stats[level],
-                                 ends[0, level])
-            else:
-                if level == 0:
-                    _first_level(y, cut, centre, slope, scale, order, count - k_cut, k_cut, z_cut, half, right_hi,
-                                 right_lo, right_acc[0], ends[1, 0])
-                else:
-                    _upper_level(right_hi, right_lo, order, count - k_cut, k_cut, z_cut, half, right_hi, right_lo,
-                                 right_acc[level], ends[1, level])
-    count = n
-    top_hi = left_hi
-    top_lo = left_lo
-    if split > 0:
-        for level in range(split):  # the two stretches' moments, and the differences across the cut
-            row = stats[level]
-            for c in range(9):
-                row[c] += right_acc[level, c]
-            for c in (9, 11, 13, 15):
-                row[c] = right_acc[level, c]
-            _seam(ends[0, level], ends[1, level], order, row)
-        count = n >> split
-        k_cut = cut >> split
-        top_hi = np.concatenate((left_hi[:k_cut], right_hi[: count - k_cut]))  # side by side
-        top_lo = np.concatenate((left_lo[:k_cut], right_lo[: count - k_cut]))
-    one_end = np.zeros((2, 6))
-    for level in range(split, n_levels):
-        if count <= tails.shape[1]:
-            for j in range(count):
-                h, l = _value(y, 0, centre, slope, scale, top_hi, top_lo, level == 0, j)
-                tails[level, j] = h + l
-        if level == 0:
-            _first_level(y, 0, centre, slope, scale, order, count, 0, 0.0, count / 2.0, top_hi, top_lo, stats[0],
-                         one_end)
-        else:
-            _upper_level(top_hi, top_lo, order, count, 0, 0.0, count / 2.0, top_hi, top_lo, stats[level], one_end)
+    block_exp = BLOCK_EXP
+    n_blocks = -(-n >> block_exp) if n > 0 else 0
+    full = n >> block_exp
+    low = min(n_levels, block_exp)
+    sides = 2 if n_blocks >= SPLIT_BLOCKS else 1
+    cut = n_blocks // 2 if sides == 2 else n_blocks  # the right stretch starts at this block
+    z_cut = _phase_at(y, centre, slope, scale, cut << block_exp) if sides == 2 else 0.0
+    states = np.zeros((2, max(low, 1), STATE))
+    for level in range(low):
+        _start(states[0, level], n >> level, 0, 0.0)
+        _start(states[1, level], n >> level, cut << (block_exp - level), z_cut)
+    top_hi = np.empty(max(full, 1))
+    top_lo = np.empty(max(full, 1))
+    for side in prange(sides):
+        first = 0 if side == 0 else cut
+        stop = cut if side == 0 else n_blocks
+        _stretch(y, centre, slope, scale, order, first, stop, low, states[side], top_hi, top_lo, tails, block_exp)
+    for level in range(low):
+        row = stats[level]
+        _moments_row(states[0, level], n >> level, row)
+        if sides == 2:  # the right stretch's sums, its ends, and the differences across the cut
+            right = states[1, level]
+            row[1] += right[_S0]
+            row[2] += right[_S1]
+            row[3] += right[_S2]
+            row[4] += right[_Q0]
+            row[5] += right[_VSQ]
+            row[6] += right[_E1]
+            row[7] += right[_E2]
+            row[8] += right[_E3]
+            row[9], row[11], row[13], row[15] = right[_Z], right[_PH] + right[_PL], right[_PD1], right[_PD2]
+            _seam(states[0, level], right, order, row)
+    state = np.zeros(STATE)
+    count = full
+    no_tail = np.empty(0)
+    for level in range(low, n_levels):  # the upper levels: on the full blocks' sums, in place
+        _start(state, count, 0, 0.0)
+        tail = tails[level] if count <= tails.shape[1] else no_tail
+        _upper_chunk(top_hi, top_lo, order, count, 0, state, top_hi, top_lo, tail, 0)
+        _moments_row(state, count, stats[level])
         count //= 2
