@@ -163,3 +163,44 @@ def test_long_series_non_finite_values_are_found_by_the_kernel_pass(type):
         x[position] = np.inf
         with pytest.raises(ValueError, match=rf"1 non-finite value\(s\) \(0 NaN, 1 inf\); the first is at index {position}"):
             avar.avar(x, type=type)
+
+
+def test_certified_plain_sums_are_taken_only_when_provably_accurate():
+    """White noise takes the plain float64 sums (equal to the compensated ones to 1e-13); an
+    offset far above the noise, a drift or a random walk fail the bound and take the
+    compensated path, so the result stays exact."""
+    from avar._kernels.streaming import certified_squares, fill_prefix, plain_squares, squares
+
+    n, m = 5000, 4
+    for name, x, plain_expected in [("white", np.random.default_rng(5).standard_normal(n), True),
+                                    *[(k, v, False) for k, v in adversarial(n).items() if k != "offset"]]:
+        data = x[:, None]
+        hi, lo, bounds = np.empty(n + 1), np.empty(n + 1), np.zeros(2)
+        fill_prefix(data, 0, 0, n, float(np.mean(x)), 1.0, 0.0, 0.0, hi, lo, 0, bounds)
+        count = n + 1 - 2 * m
+        got = certified_squares(hi, lo, 0, m, count, np.empty(0), bounds)
+        compensated = squares(hi, lo, 0, hi, lo, m, hi, lo, 2 * m, count, np.empty(count))
+        assert (got == plain_squares(hi, 0, m, count)) == plain_expected, name
+        assert got == pytest.approx(compensated, rel=1e-13), name
+        assert got / (2.0 * m * m * count) == pytest.approx(exact(x, [m], "mo")[0], rel=1e-10), name
+
+
+@pytest.mark.parametrize("name", ["white", "offset", "drift", "random walk", "step"])
+def test_small_path_on_threads_is_exact_and_thread_independent(name):
+    """The small path with the levels shared among the threads (N up to SMALL_MO_MAX)."""
+    from avar._kernels.small import small_allan_variance_parallel
+
+    n = columns.SMALL_MAX + 1001
+    x = np.random.default_rng(8).standard_normal(n) if name == "white" else adversarial(n)[name]
+    factors = octave(n, first=0)
+    nd = n_diff(n, factors, "mo")
+    got = small_allan_variance_parallel(x[:, None], factors, nd, True, False)[0]
+    np.testing.assert_array_equal(got, small_allan_variance(x[:, None], factors, nd, True, False)[0])
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        np.testing.assert_array_equal(small_allan_variance_parallel(x[:, None], factors, nd, True, False)[0], got)
+    finally:
+        numba.set_num_threads(threads)
+    picks = factors[[0, 5, -1]]
+    np.testing.assert_allclose(got[[0, 5, -1]], exact(x, picks, "mo"), rtol=1e-10)

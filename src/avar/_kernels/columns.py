@@ -11,7 +11,7 @@ from numba import njit
 from avar._kernels.haar import CHUNK_BLOCKS as HAAR_CHUNK
 from avar._kernels.haar import PYRAMID_EXP, haar_sums
 from avar._kernels.levels import level_sums
-from avar._kernels.small import small_allan_variance
+from avar._kernels.small import small_allan_variance, small_allan_variance_parallel
 from avar._kernels.streaming import BLOCK, CHUNK_BLOCKS, LIMIT_EXP, NEAR, block_table
 from avar._kernels.sweep import SWEEP_BLOCK, SWEEP_CHUNK, SWEEP_NEAR, sweep_sums
 
@@ -20,6 +20,11 @@ from avar._kernels.sweep import SWEEP_BLOCK, SWEEP_CHUNK, SWEEP_NEAR, sweep_sums
 #: a sample; starting the thread pool would cost more than the work. (Decided
 #: on N alone: a column's bits do not depend on the other columns.)
 SMALL_MAX = 1 << 15
+
+#: Octave-or-not "mo" series of at most this many samples take the small path with the
+#: levels shared among the threads (24 bytes a sample of workspace): below this the
+#: sweep's halos cost more than the full cumulative sum.
+SMALL_MO_MAX = 1 << 18
 
 
 @njit(cache=True)
@@ -139,6 +144,8 @@ def allan_variance_columns(data, factors, type: str) -> np.ndarray:
     nd = n - 2 * fs + 1 if is_mo else n // fs - 1
     if small:
         values = small_allan_variance(x, fs, nd, is_mo, x.dtype.kind in "iu")
+    elif is_mo and n <= SMALL_MO_MAX:
+        values = small_allan_variance_parallel(x, fs, nd, is_mo, x.dtype.kind in "iu")
     else:
         # Tasks are handed out one at a time (not in one contiguous range per thread):
         # a thread slowed down by another process then holds back no other thread.

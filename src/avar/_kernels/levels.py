@@ -39,6 +39,8 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
     rs = np.full(2, -1, dtype=np.int64)
     re_ = np.full(2, -2, dtype=np.int64)
     buffer = np.empty(block)
+    bounds = np.zeros(2)  # largest |S| hi and lo parts the window has held
+    unused = np.zeros(2)  # the regions' magnitudes, not needed
     idx = np.empty(2, dtype=np.int64)
     w0 = kb0 * block
     filled = 0
@@ -49,7 +51,7 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
         if t0 >= nd[0]:
             break
         w0, filled = window_level_sums(data, col, t0, min(n, t0 + block + 2 * near), centre, scale, nh, nl, w0,
-                                       filled, factors, nd, small_count, block, out_row, buffer)
+                                       filled, factors, nd, small_count, block, out_row, buffer, bounds)
         a = t0 - w0
         for k in range(small_count, n_levels):
             cnt = min(block, nd[k] - t0)
@@ -65,7 +67,7 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
                     where = 0 if used != 0 else 1
                     q = p // block
                     fill_prefix(data, col, q * block, p + cnt - 1, centre, scale, th[col, q], tl[col, q],
-                                rh[where], rl[where], 0)
+                                rh[where], rl[where], 0, unused)
                     rs[where] = q * block
                     re_[where] = p + cnt - 1
                 if where >= 0:
@@ -107,12 +109,13 @@ def to_task(data, col, kb0, kb1, centre, scale, th, tl, factors, clusters, out_r
             have[k] = 2
     bh = np.empty(block + 1)
     bl = np.empty(block + 1)
+    unused = np.zeros(2)  # fill_prefix's magnitudes, not needed here
     for kb in range(kb0, kb1):
         t0 = kb * block
         if t0 >= last_pos:
             break
         stop = min(n, t0 + block, last_pos)
-        fill_prefix(data, col, t0, stop, centre, scale, th[col, kb], tl[col, kb], bh, bl, 0)
+        fill_prefix(data, col, t0, stop, centre, scale, th[col, kb], tl[col, kb], bh, bl, 0, unused)
         for k in range(n_levels):
             m = factors[k]
             e = (t0 // m + 1) * m

@@ -1,14 +1,18 @@
-"""The small-input path of the Allan variance (numba): one call, one thread, no workspace.
+"""The small-input path of the Allan variance (numba): one call, no workspace.
 
 For short series the cost of a call is dispatch, thread start-up and
 allocation, not arithmetic. Here one compiled function does everything for
-every column: a compensated sum (the exact centre and the largest
+every column: a plain sum (a centre near the mean, and the largest
 magnitude), the centred compensated cumulative sum ``S = hi + lo`` of the
 column (2 x 8 bytes a sample, at most :data:`avar._kernels.columns.SMALL_MAX`
 samples) and, per level, the squared second differences
 ``D = S[b + 2m] - 2 S[b + m] + S[b]`` (``b`` every sample for "mo", every
 ``m`` samples for "to"). The arithmetic is that of :mod:`streaming`: exact
-centred pairs, TwoSum accumulation, compensated differences.
+centred pairs, TwoSum accumulation, compensated differences ("mo": plain
+ones where :func:`avar._kernels.streaming.certified_squares` proves them
+accurate). :func:`small_allan_variance` runs on one thread (the shortest
+calls: starting the thread pool would cost more than the work);
+:func:`small_allan_variance_parallel` shares the levels among the threads.
 """
 
 from __future__ import annotations
@@ -16,9 +20,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
-from avar._kernels.streaming import LIMIT_EXP, _block_sum, fill_prefix, squares
+from avar._kernels.streaming import LIMIT_EXP, certified_squares, fill_prefix
 
 
 @njit(cache=True)
@@ -28,6 +32,49 @@ def _scale_of(big):
         _, e = math.frexp(big)
         return math.ldexp(1.0, -min(max(e, -1000), 1000))
     return 1.0
+
+
+@njit(cache=True, fastmath={"reassoc", "contract"})
+def _sum_and_big(data, c, scale):
+    """Plain (vectorized) sum and largest magnitude of ``data[:, c] * scale``."""
+    x = data[:, c]
+    total = 0.0
+    big = 0.0
+    for i in range(x.shape[0]):
+        v = np.float64(x[i]) * scale
+        total += v
+        big = max(big, abs(v))
+    return total, big
+
+
+@njit(cache=True)
+def _prepare(data, c, integral, hi, lo, bounds):
+    """Fill ``hi/lo`` with the centred compensated cumulative sum of column ``c`` (and ``bounds``
+    with its largest parts); return the power-of-two scale applied."""
+    n = data.shape[0]
+    total, big = _sum_and_big(data, c, 1.0)
+    scale = _scale_of(big)
+    if scale != 1.0:
+        total, big = _sum_and_big(data, c, scale)
+    centre = total / n  # any centre keeps S exact; near the mean keeps it small
+    if integral:
+        centre = np.round(centre)
+    bounds[:] = 0.0
+    fill_prefix(data, c, 0, n, centre, scale, 0.0, 0.0, hi, lo, 0, bounds)
+    return scale
+
+
+@njit(cache=True, inline="always")
+def _level(hi, lo, m, count, is_mo, bounds, buffer):
+    """Sum of the ``count`` squared second differences of level ``m``."""
+    if is_mo:
+        return certified_squares(hi, lo, 0, m, count, buffer, bounds)
+    total = 0.0
+    for j in range(count):
+        b = j * m
+        d = ((hi[b + 2 * m] - hi[b + m]) - (hi[b + m] - hi[b])) + ((lo[b + 2 * m] - lo[b + m]) - (lo[b + m] - lo[b]))
+        total += d * d
+    return total
 
 
 @njit(cache=True)
@@ -43,29 +90,33 @@ def small_allan_variance(data, factors, counts, is_mo, integral):
     hi = np.empty(n + 1)
     lo = np.empty(n + 1)
     buffer = np.empty(n)
+    bounds = np.zeros(2)
     for c in range(channels):
-        total, comp, big = _block_sum(data, c, 0, n, 1.0)
-        scale = _scale_of(big)
-        if scale != 1.0:
-            total, comp, big = _block_sum(data, c, 0, n, scale)
-        centre = (total + comp) / n
-        if integral:
-            centre = np.round(centre)
-        fill_prefix(data, c, 0, n, centre, scale, 0.0, 0.0, hi, lo, 0)
+        scale = _prepare(data, c, integral, hi, lo, bounds)
         unscale = 1.0 / scale
         for k in range(n_levels):
-            m = factors[k]
-            count = counts[k]
-            if is_mo:
-                sums = squares(hi, lo, 0, hi, lo, m, hi, lo, 2 * m, count, buffer)
-            else:
-                sums = 0.0
-                for j in range(count):
-                    b = j * m
-                    d = ((hi[b + 2 * m] - hi[b + m]) - (hi[b + m] - hi[b])) + (
-                        (lo[b + 2 * m] - lo[b + m]) - (lo[b + m] - lo[b])
-                    )
-                    sums += d * d
-            mf = np.float64(m)
-            out[c, k] = sums / (2.0 * mf * mf * count) * unscale * unscale
+            mf = np.float64(factors[k])
+            sums = _level(hi, lo, factors[k], counts[k], is_mo, bounds, buffer)
+            out[c, k] = sums / (2.0 * mf * mf * counts[k]) * unscale * unscale
+    return out
+
+
+@njit(cache=True, parallel=True)
+def small_allan_variance_parallel(data, factors, counts, is_mo, integral):
+    """:func:`small_allan_variance` with the levels shared among the threads (each level's
+    sum is one thread's: the bits do not depend on the thread count)."""
+    n, channels = data.shape
+    n_levels = factors.shape[0]
+    out = np.empty((channels, n_levels))
+    hi = np.empty(n + 1)
+    lo = np.empty(n + 1)
+    bounds = np.zeros(2)
+    for c in range(channels):
+        scale = _prepare(data, c, integral, hi, lo, bounds)
+        unscale = 1.0 / scale
+        for k in prange(n_levels):
+            buffer = np.empty(0)  # certified_squares allocates one if it needs it
+            mf = np.float64(factors[k])
+            sums = _level(hi, lo, factors[k], counts[k], is_mo, bounds, buffer)
+            out[c, k] = sums / (2.0 * mf * mf * counts[k]) * unscale * unscale
     return out

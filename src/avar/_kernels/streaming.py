@@ -191,8 +191,12 @@ def _finish_table(bh, bl, bm, n, block, integral):
 
 
 @njit(cache=True)
-def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at):
+def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at, bounds):
     """``out[at + i] = S[start + i]`` for ``i = 0 .. stop - start`` from ``S[start] = (s_hi, s_lo)``.
+
+    Stored renormalized (``out_hi`` is ``S`` rounded to float64, ``out_lo`` the
+    rest), so that :func:`certified_squares` can use ``out_hi`` alone; ``bounds``
+    is raised to the largest ``|out_hi|`` and ``|out_lo|`` written (see :func:`magnitudes`).
 
     (Loops run over slices with ``range(count)``: non-negative indices, so
     numba emits no wraparound checks and LLVM can vectorize the loads.)
@@ -205,12 +209,19 @@ def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_l
     comp = s_lo
     out_hi[at] = total
     out_lo[at] = comp
+    big_h = max(bounds[0], abs(total))
+    big_l = max(bounds[1], abs(comp))
     for i in range(count):
         yh, yl = _centred(x[i], centre, scale)
         total, e = _two_sum(total, yh)
         comp += e + yl
-        oh[i] = total
-        ol[i] = comp
+        h, l = _two_sum(total, comp)  # stored renormalized: h the rounded S, |l| <= ulp / 2
+        oh[i] = h
+        ol[i] = l
+        big_h = max(big_h, abs(h))
+        big_l = max(big_l, abs(l))
+    bounds[0] = big_h
+    bounds[1] = big_l
 
 
 @njit(cache=True)
@@ -250,14 +261,56 @@ def squares(h0, l0, a0, h1, l1, a1, h2, l2, a2, count, buffer):
     return _fast_sum(buffer, count)
 
 
+#: Relative bound on the error of a plain (float64) sum of squared differences accepted by
+#: :func:`certified_squares`; beyond it the compensated :func:`squares` runs.
+CERTIFY_TOL = 1e-12
+_EPS = 2.0**-53
+
+
+@njit(cache=True, fastmath={"reassoc", "contract"})
+def plain_squares(h, a, m, count):
+    """Sum over ``j < count`` of ``(h[a+j+2m] - 2 h[a+j+m] + h[a+j])**2`` in plain float64 (vectorized)."""
+    x0 = h[a : a + count]
+    x1 = h[a + m : a + m + count]
+    x2 = h[a + 2 * m : a + 2 * m + count]
+    total = 0.0
+    for j in range(count):
+        d = (x2[j] - x1[j]) - (x1[j] - x0[j])
+        total += d * d
+    return total
+
+
+@njit(cache=True)
+def certified_squares(h, l, a, m, count, buffer, bounds):
+    """:func:`squares` of one window (``S = h + l`` at offsets a, a + m, a + 2m) by the plain
+    :func:`plain_squares` of ``h`` alone when its error is provably below :data:`CERTIFY_TOL`.
+
+    Every term then errs by at most ``delta = 4 max|l| + 16 eps max|h|`` (``bounds``:
+    those maxima over the window, from :func:`fill_prefix`; ``l`` dropped, any association of the three float
+    subtractions), so the sum of ``count`` squares by at most
+    ``2 delta sqrt(count * sum) + count delta**2``. White-noise-like data pass; a large
+    excursion of the centred cumulative sum (drift, offset, random walk) takes the
+    compensated path, so the result keeps its accuracy either way. ``buffer``: the
+    compensated path's workspace (allocated here if shorter than ``count``).
+    """
+    total = plain_squares(h, a, m, count)
+    delta = 4.0 * bounds[1] + 16.0 * _EPS * bounds[0]
+    if total > 0.0 and 2.0 * delta * np.sqrt(count * total) + count * delta * delta <= CERTIFY_TOL * total:
+        return total
+    if buffer.shape[0] < count:  # a workspace only when needed
+        buffer = np.empty(count)
+    return squares(h, l, a, h, l, a + m, h, l, a + 2 * m, count, buffer)
+
+
 @njit(cache=True)
 def window_level_sums(data, col, t0, need, centre, scale, wh, wl, w0, filled, factors, nd, count, block, out_row,
-                      buffer):
+                      buffer, bounds):
     """Squared second differences of the first ``count`` levels for the block at ``t0``, from a sliding window.
 
     The window holds the compensated prefix sums ``S[w0 .. w0 + filled]`` in ``wh``/``wl``; it slides to
     start at ``t0`` when ``need`` would overrun its length and is filled up to ``need``. Adds into
-    ``out_row[:count]`` and returns the new ``(w0, filled)``.
+    ``out_row[:count]`` and returns the new ``(w0, filled)``. ``bounds``: the largest
+    ``|wh|`` and ``|wl|`` the window has held (for :func:`certified_squares`; kept by the caller).
     """
     if need - w0 >= wh.shape[0]:
         shift = t0 - w0
@@ -267,12 +320,11 @@ def window_level_sums(data, col, t0, need, centre, scale, wh, wl, w0, filled, fa
         w0 = t0
         filled -= shift
     if w0 + filled < need:
-        fill_prefix(data, col, w0 + filled, need, centre, scale, wh[filled], wl[filled], wh, wl, filled)
+        fill_prefix(data, col, w0 + filled, need, centre, scale, wh[filled], wl[filled], wh, wl, filled, bounds)
         filled = need - w0
     a = t0 - w0
     for k in range(count):
         cnt = min(block, nd[k] - t0)
         if cnt > 0:
-            m = factors[k]
-            out_row[k] += squares(wh, wl, a, wh, wl, a + m, wh, wl, a + 2 * m, cnt, buffer)
+            out_row[k] += certified_squares(wh, wl, a, factors[k], cnt, buffer, bounds)
     return w0, filled

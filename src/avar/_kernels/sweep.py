@@ -125,6 +125,7 @@ def sweep_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, n_small,
     rh = np.empty((3, block))
     rl = np.empty((3, block))
     buffer = np.empty(block)
+    bounds = np.zeros(2)  # largest |S| hi and lo parts the window has held
     w0 = kb0 * block
     filled = 0
     wh[0] = th[col, kb0]
@@ -135,7 +136,7 @@ def sweep_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, n_small,
             break
         if n_small > 0:
             w0, filled = window_level_sums(data, col, t0, min(n, t0 + block + halo), centre, scale, wh, wl, w0,
-                                           filled, factors, nd, n_small, block, out_row, buffer)
+                                           filled, factors, nd, n_small, block, out_row, buffer, bounds)
         if n_small == n_levels or nd[n_small] <= t0:
             continue
         # large levels: region 0 (this block), then the m and 2m regions level by level
