@@ -67,7 +67,7 @@ def gmwm(
     taus : "octave" or as in :func:`avar.avar`
         Scales: ``"octave"`` is m = 1, 2, 4, ... 2**(floor(log2 N) - 1) (the
         octave grid of ``avar`` plus m = 1, which separates QN from WN).
-    weights : {"diagonal", "full", "identity"}
+    weights : {"diagonal", "full", "efficient", "identity"}
         ``"diagonal"`` (default): W = diag(1 / var(nu_hat_j)) with the
         asymptotic approximation var(nu_hat_j) = 2 nu_j(theta_1)^2 / edf_j,
         edf_j = (N - 2 m_j + 1) / m_j, at a first log-scale fit theta_1: a closed
@@ -75,7 +75,12 @@ def gmwm(
         covariance of nu_hat from a short parametric bootstrap (200 series) at
         theta_1: it captures the correlation between neighbouring scales, which
         has no simple closed form for a sum of processes, at the price of
-        simulating 200 series. ``"identity"``: unweighted on the log scale.
+        simulating 200 series. ``"efficient"``: W the inverse of the exact
+        Gaussian covariance of nu_hat at theta_1, computed from the
+        autocovariance of the first differences
+        (:mod:`avar.fit.gmwm_covariance`; "mo" AV of WN, QN, RW, DR and AR1
+        only): the asymptotically optimal weighting, without simulation.
+        ``"identity"``: unweighted on the log scale.
     ci : bool
         Parametric bootstrap: simulate the fitted model ``B`` times at the same
         N, refit each, report standard errors and intervals (see
@@ -170,7 +175,14 @@ def fit_allan_variance(
     edf = equivalent_dof(av.n, factors, np.asarray(av.n_differences), av.type)
     rng = np.random.default_rng(seed)
     covariance = None
-    if weights == "full":
+    if weights == "efficient":
+        from avar.fit.gmwm_covariance import check_supported, mo_av_covariance
+
+        check_supported(spec.classes, av.type)
+
+        def covariance(theta: np.ndarray) -> np.ndarray:
+            return mo_av_covariance(spec.model(theta), av.n, factors)
+    elif weights == "full":
         from avar.fit.gmwm_bootstrap import av_covariance
 
         def covariance(theta: np.ndarray) -> np.ndarray:

@@ -21,7 +21,9 @@ It runs in two steps, each a Levenberg-Marquardt least-squares fit
    residuals on the linear scale, where nu_hat is unbiased, so the log bias
    -1 / edf_j of step 1 does not reach the estimates). ``"full"``: W the
    inverse of a covariance matrix of nu_hat (from a short parametric
-   bootstrap at theta_1, see :mod:`avar.fit.gmwm_bootstrap`).
+   bootstrap at theta_1, see :mod:`avar.fit.gmwm_bootstrap`); ``"efficient"``:
+   W the inverse of the exact Gaussian covariance of nu_hat at theta_1
+   (:mod:`avar.fit.gmwm_covariance`), the optimal GMM weight.
    ``"identity"``: step 1 alone, with edf_j = 2 (unweighted log scale).
 
 Starting values: each process whose values are not given starts on the
@@ -53,7 +55,7 @@ TOLERANCE = 1e-12
 TRIAL_POSITIONS = (0.2, 0.5, 0.8)
 #: Function evaluations given to each starting point before the best one is finished.
 SCREEN_EVALUATIONS = 6
-WEIGHTINGS = ("diagonal", "full", "identity")
+WEIGHTINGS = ("diagonal", "full", "efficient", "identity")
 
 
 def equivalent_dof(n: int, factors: np.ndarray, counts: np.ndarray, type: str) -> np.ndarray:
@@ -163,7 +165,7 @@ def fit_av(
     """Fit ``spec`` to the Allan variances ``nu_hat`` at ``factors`` (both steps).
 
     ``starts``: unconstrained starting vectors (default :func:`starting_points`).
-    ``covariance(theta_1)``: the covariance of nu_hat for ``weights="full"``;
+    ``covariance(theta_1)``: the covariance of nu_hat for ``weights="full"`` or ``"efficient"``;
     ``whitener``: a fixed step-2 weight instead, with one start: step 2 alone
     runs (the bootstrap refits reuse the data's weights, so a replicate
     costs one least-squares run from the data's estimate).

@@ -40,7 +40,7 @@ class GmwmResult:
         The minimized (nu_hat - nu)' W (nu_hat - nu) (a chi-square-like value
         with about L - p degrees of freedom for the default weights).
     weights : str
-        ``"diagonal"``, ``"full"`` or ``"identity"``.
+        ``"diagonal"``, ``"full"``, ``"efficient"`` or ``"identity"``.
     ci : pandas.DataFrame or None
         With ``ci=True``: ``Estimate``, ``SE``, ``Lower``, ``Upper`` per parameter.
     alpha, replicates : float, int or None
