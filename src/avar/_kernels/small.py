@@ -34,9 +34,10 @@ def _scale_of(big):
     return 1.0
 
 
-@njit(cache=True, fastmath={"reassoc", "contract"})
+@njit(cache=True)
 def _sum_and_big(data, c, scale):
-    """Plain (vectorized) sum and largest magnitude of ``data[:, c] * scale``."""
+    """Plain sum and largest magnitude of ``data[:, c] * scale``, in index order (a
+    vectorized sum would depend on the memory layout, and so would the bits)."""
     x = data[:, c]
     total = 0.0
     big = 0.0

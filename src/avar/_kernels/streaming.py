@@ -263,7 +263,7 @@ def squares(h0, l0, a0, h1, l1, a1, h2, l2, a2, count, buffer):
 
 #: Relative bound on the error of a plain (float64) sum of squared differences accepted by
 #: :func:`certified_squares`; beyond it the compensated :func:`squares` runs.
-CERTIFY_TOL = 1e-12
+CERTIFY_TOL = 1e-11
 _EPS = 2.0**-53
 
 
@@ -285,16 +285,18 @@ def certified_squares(h, l, a, m, count, buffer, bounds):
     """:func:`squares` of one window (``S = h + l`` at offsets a, a + m, a + 2m) by the plain
     :func:`plain_squares` of ``h`` alone when its error is provably below :data:`CERTIFY_TOL`.
 
-    Every term then errs by at most ``delta = 4 max|l| + 16 eps max|h|`` (``bounds``:
-    those maxima over the window, from :func:`fill_prefix`; ``l`` dropped, any association of the three float
-    subtractions), so the sum of ``count`` squares by at most
+    Every term then errs by at most ``delta = 4 max|l| + 9 u max|h|`` (u = 2**-53;
+    ``bounds``: those maxima over the window, from :func:`fill_prefix`): dropping ``l``
+    costs ``4 max|l|``, and any association of ``h2 - 2 h1 + h0`` rounds twice on values
+    of at most ``4 max|h|`` (``8 u max|h|``, to first order). So the sum of ``count``
+    squares errs by at most
     ``2 delta sqrt(count * sum) + count delta**2``. White-noise-like data pass; a large
     excursion of the centred cumulative sum (drift, offset, random walk) takes the
     compensated path, so the result keeps its accuracy either way. ``buffer``: the
     compensated path's workspace (allocated here if shorter than ``count``).
     """
     total = plain_squares(h, a, m, count)
-    delta = 4.0 * bounds[1] + 16.0 * _EPS * bounds[0]
+    delta = 4.0 * bounds[1] + 9.0 * _EPS * bounds[0]
     if total > 0.0 and 2.0 * delta * np.sqrt(count * total) + count * delta * delta <= CERTIFY_TOL * total:
         return total
     if buffer.shape[0] < count:  # a workspace only when needed

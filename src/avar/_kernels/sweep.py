@@ -128,8 +128,10 @@ def sweep_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, n_small,
     bounds = np.zeros(2)  # largest |S| hi and lo parts the window has held
     w0 = kb0 * block
     filled = 0
-    wh[0] = th[col, kb0]
-    wl[0] = tl[col, kb0]
+    # The window holds S less S[kb0 B] (differences need no anchor): its values stay the
+    # size of the task's own excursion, which lets certified_squares use plain sums.
+    wh[0] = 0.0
+    wl[0] = 0.0
     for kb in range(kb0, kb1):
         t0 = kb * block
         if t0 >= nd[0]:
