@@ -143,7 +143,7 @@ def test_octave_noise_equals_the_phase_path(estimator, alpha):
         factors = deviation_factors(estimator, y.size + 1)
         _, _, _, moments, drift = _octave_sums(estimator, y, factors, scan(y))
         dmax = NOISE_ID_ESTIMATORS[estimator]
-        got = octave_noise(moments.stats, moments.tails, factors, dmax, drift, moments.phase)
+        got = octave_noise(moments.stats, moments.tails, factors, dmax, drift, moments.phase, moments.clusters)
         want = phase_noise(moments.phase(), factors, dmax, drift, line_free=True)
         np.testing.assert_array_equal(got, want)
 
@@ -152,3 +152,40 @@ def test_constant_level_has_no_alpha():
     stats = np.zeros((1, len(MOMENTS)))
     stats[0, 0] = 100.0
     assert np.isnan(lag1_alpha_from_moments(stats[0], 2))
+
+
+@pytest.mark.parametrize("step", [1, 4, 64])
+@pytest.mark.parametrize("n", [10_003, 64 * 157 - 1])
+def test_rn_clusters_equal_the_phase_and_its_running_sum(step, n):
+    from avar._kernels.noise_id import rn_clusters
+
+    y = 2.0 + np.random.default_rng(step).standard_normal(n)
+    centre, slope, scale = 2.0, 1e-5, 0.5
+    x = np.concatenate(([0.0], np.cumsum((y - centre - slope * np.arange(n)) * scale)))
+    z = np.empty(n // step + 1)
+    running = np.empty((n + 1) // step + 1)
+    rn_clusters(y, centre, slope, scale, step, z, running)
+    np.testing.assert_allclose(z, x[np.arange(z.size) * step], rtol=1e-10, atol=1e-10 * np.abs(x).max())
+    sums = np.concatenate(([0.0], np.cumsum(x)))[np.arange(running.size) * step]
+    np.testing.assert_allclose(running, sums, rtol=1e-10, atol=1e-10 * np.abs(sums).max())
+
+
+def test_r_n_from_clusters_never_builds_the_phase():
+    """White FM often makes B1 say PM at the top levels; R(n) then runs on the clusters."""
+    built = 0
+    for seed in range(6):
+        y = np.random.default_rng(seed).standard_normal(200_000)
+        for estimator in ("adev", "hdev"):
+            factors = deviation_factors(estimator, y.size + 1)
+            _, _, _, moments, drift = _octave_sums(estimator, y, factors, scan(y))
+            dmax = NOISE_ID_ESTIMATORS[estimator]
+            calls = []
+
+            def phase(moments=moments, calls=calls):
+                calls.append(1)
+                return moments.phase()
+
+            got = octave_noise(moments.stats, moments.tails, factors, dmax, drift, phase, moments.clusters)
+            np.testing.assert_array_equal(got, phase_noise(moments.phase(), factors, dmax, drift, line_free=True))
+            built += len(calls)
+    assert built == 0

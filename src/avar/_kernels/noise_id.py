@@ -246,3 +246,35 @@ def lag1_alpha_from_moments(row, dmax):
         total, squares, first, last, raw = n_total, n_squares, n_first, n_last, n_raw
         length -= 1.0
     return np.nan
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def rn_clusters(y, centre, slope, scale, step, z, running):
+    """What R(n) needs at stride ``step`` from frequency data, without the phase.
+
+    With ``x_i = sum_{j < i} (y_j - centre - slope j) scale`` the detrended
+    phase (N + 1 points), fill ``z[k] = x[k step]`` (k = 0 .. N // step) and
+    ``running[k] = sum_{i < k step} x_i`` (k = 0 .. (N + 1) // step): the
+    ``step`` phase points from ``k step`` add ``step x[k step] + sum_r
+    (step - 1 - r) y'_{k step + r}``. One pass over the data (plain sums: R(n)
+    is a ratio).
+    """
+    n = y.shape[0]
+    z[0] = 0.0
+    running[0] = 0.0
+    phase = 0.0
+    total = 0.0
+    for k in range((n + 1) // step):
+        base = k * step
+        weighted = 0.0
+        cluster = 0.0
+        for r in range(step - 1):
+            v = ((y[base + r] - centre) - slope * (base + r)) * scale
+            cluster += v
+            weighted += (step - 1 - r) * v
+        total += step * phase + weighted
+        running[k + 1] = total
+        if base + step <= n:  # the phase at the next cluster
+            last = base + step - 1
+            phase += cluster + ((y[last] - centre) - slope * last) * scale
+            z[k + 1] = phase

@@ -20,6 +20,7 @@ import numpy as np
 
 from avar._kernels.deviation_phase import centred_moment
 from avar._kernels.deviations import detrended_phase, level_sums, scan
+from avar._kernels.noise_id import rn_clusters
 from avar._kernels.pyramid import MOMENTS, SUM_COLUMN, TAIL, octave_moments
 from avar.stability.deviation_grids import KERNEL_CODES, term_counts, term_ranges
 
@@ -74,12 +75,14 @@ class OctaveMoments(NamedTuple):
     ``stats``: the moments of every level (columns ``MOMENTS``); ``tails``:
     the cluster sums of the levels with at most ``TAIL`` clusters;
     ``phase()``: builds the detrended phase (one O(N) pass), for the rare
-    level the moments cannot decide.
+    level the moments cannot decide; ``clusters(step)``: the phase at every
+    ``step``-th point and its running sum there, for R(n).
     """
 
     stats: np.ndarray
     tails: np.ndarray
     phase: Callable[[], np.ndarray]
+    clusters: Callable[[int], tuple[np.ndarray, np.ndarray]]
 
 
 def _octave_sums(estimator: str, data: np.ndarray, factors: np.ndarray, scanned: tuple):
@@ -99,7 +102,13 @@ def _octave_sums(estimator: str, data: np.ndarray, factors: np.ndarray, scanned:
     def phase() -> np.ndarray:
         return phase_parts(data, "freq", estimator, scanned)[5]
 
-    moments = OctaveMoments(stats, tails, phase)
+    def clusters(step: int) -> tuple[np.ndarray, np.ndarray]:
+        z = np.empty(count // step + 1)
+        running = np.empty((count + 1) // step + 1)
+        rn_clusters(data, float(centre), slope, scale, step, z, running)
+        return z, running
+
+    moments = OctaveMoments(stats, tails, phase, clusters)
     return sums, term_counts(estimator, count + 1, factors), scale, moments, slope * scale
 
 

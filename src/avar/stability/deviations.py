@@ -142,7 +142,8 @@ def _shared_phase_noise(estimator: str, phase: np.ndarray | OctaveMoments, drift
     """:func:`noise_exponents` of gap-free data from the detrended phase of the variances,
     or from the moments of the pyramid's levels."""
     if isinstance(phase, OctaveMoments):
-        return octave_noise(phase.stats, phase.tails, factors, NOISE_ID_ESTIMATORS[estimator], drift, phase.phase)
+        return octave_noise(phase.stats, phase.tails, factors, NOISE_ID_ESTIMATORS[estimator], drift, phase.phase,
+                            phase.clusters)
     alpha = np.zeros(factors.size, dtype=np.int64)
     fits = factors < phase.size
     if phase.size >= 4 and fits.any():

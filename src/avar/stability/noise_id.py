@@ -128,20 +128,24 @@ def phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float = 0.0, lin
 
 
 def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int, drift: float,
-                 phase: Callable[[], np.ndarray]) -> np.ndarray:
+                 phase: Callable[[], np.ndarray],
+                 clusters: Callable[[int], tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
     """:func:`phase_noise` at the octave factors ``m`` = 1, 2, 4, ... from the pyramid's moments.
 
     ``stats``, ``tails``: per level, the moments and the small levels'
     cluster sums of :func:`avar._kernels.pyramid.octave_moments` (the phase
-    is never built for them); ``phase()`` builds the detrended phase, called
-    only for a level the moments cannot decide: one whose sums lost too many
-    digits to cancellation (a frequency drift far above the noise in ADEV),
-    or one where B1 says PM and R(n) must split white from flicker.
+    is never built for them). Where B1 says PM, R(n) splits white from
+    flicker from ``clusters(step)``: the phase at every ``step``-th point and
+    its running sum there (:func:`avar._kernels.noise_id.rn_clusters`, one
+    plain pass over the data). ``phase()`` builds the detrended phase, called
+    only for a level whose moments lost too many digits to cancellation (a
+    frequency drift far above the noise in ADEV).
     """
     from avar._kernels.noise_id import ILL_CONDITIONED, lag1_alpha_from_moments
 
     alpha = np.full(m.size, np.nan)
     undecided = []
+    n = int(stats[0, 0]) + 1  # phase points
     for i, factor in enumerate(m.tolist()):
         count = int(stats[i, 0])
         if count + 1 >= MIN_ACF_POINTS:
@@ -153,8 +157,21 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
             points = np.concatenate(([0.0], np.cumsum(tails[i, :count])))
             alpha[i] = _b1_ratio_alpha(points + drift * _triangular(index.astype(np.float64)) if drift else points,
                                        factor)
-            if np.isinf(alpha[i]):
-                undecided.append(i)
+            if np.isinf(alpha[i]):  # PM: R(n) at the stride it samples (a power of two here)
+                step = max(1, factor // RN_SUBSAMPLES)
+                z, running = clusters(step)
+
+                def points_at(index: np.ndarray, z=z, step=step) -> np.ndarray:
+                    return z[index // step] + drift * _triangular(index.astype(np.float64)) if drift else z[index // step]
+
+                def running_at(wanted: int, running=running, step=step) -> np.ndarray:
+                    assert wanted == step
+                    if not drift:
+                        return running
+                    q = np.arange(running.size, dtype=np.float64) * step  # + drift * sum_{i < q} i (i - 1) / 2
+                    return running + drift * q * (q - 1.0) * (q - 2.0) / 6.0
+
+                alpha[i] = _rn_alpha(points_at, n, running_at, factor)
     if undecided:
         alpha[undecided] = _raw_phase_noise(phase(), m[undecided], dmax, drift, line_free=True)
     return _fill(alpha, m)
