@@ -146,6 +146,7 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
     alpha = np.full(m.size, np.nan)
     undecided = []
     n = int(stats[0, 0]) + 1  # phase points
+    finest = None  # (step, z, running) of the finest R(n) stride computed so far
     for i, factor in enumerate(m.tolist()):
         count = int(stats[i, 0])
         if count + 1 >= MIN_ACF_POINTS:
@@ -159,7 +160,10 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
                                        factor)
             if np.isinf(alpha[i]):  # PM: R(n) at the stride it samples (a power of two here)
                 step = max(1, factor // RN_SUBSAMPLES)
-                z, running = clusters(step)
+                if finest is None or step % finest[0]:  # one pass serves every coarser stride
+                    finest = (step, *clusters(step))
+                every = step // finest[0]
+                z, running = finest[1][::every], finest[2][::every]
 
                 def points_at(index: np.ndarray, z=z, step=step) -> np.ndarray:
                     return z[index // step] + drift * _triangular(index.astype(np.float64)) if drift else z[index // step]
