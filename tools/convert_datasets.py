@@ -3,7 +3,7 @@
 Run once, from the repository root, when the data sets change (needs the ``dev`` extra for
 ``rdata``)::
 
-    python tools/convert_datasets.py ../shared/data
+    python tools/convert_datasets.py DIR   # the folder holding the R package's .rda files
 
 Every ``<name>.rda`` must match the SHA-256 digest of R ``avar`` 0.1.3 below. Each data set
 becomes ``src/avar/io/data/<name>.npz`` holding only numbers and strings (no pickles):

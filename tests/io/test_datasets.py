@@ -1,13 +1,14 @@
 """Tests of avar.datasets: the five IMU Allan variance data sets of R avar 0.1.3.
 
-The data sets ship inside the package (``avar/io/data/*.npz``). The tests that compare them
-with the R package's ``.rda`` files run when ``../shared/data`` is beside the repository and
-are skipped otherwise (a fresh clone).
+The data sets ship inside the package (``avar/io/data/*.npz``). The maintainers' tests that
+compare them with the R package's ``.rda`` files run when the environment variable
+``AVAR_RDA_DIR`` names a folder holding those files, and are skipped otherwise.
 """
 
 from __future__ import annotations
 
 import importlib.util
+import os
 import subprocess
 import sys
 import warnings
@@ -23,10 +24,10 @@ from avar.stability.results import AllanVariance, ImuAllanVariance
 
 GYRO, ACCEL = "Gyroscope", "Accelerometer"
 REPOSITORY = Path(__file__).resolve().parents[2]
-DATA_DIR = REPOSITORY.parent / "shared" / "data"
+DATA_DIR = Path(os.environ.get("AVAR_RDA_DIR", "")) if os.environ.get("AVAR_RDA_DIR") else None
 needs_rda = pytest.mark.skipif(
-    not DATA_DIR.is_dir() or importlib.util.find_spec("rdata") is None,
-    reason="the R package's .rda files (../shared/data) and rdata are not available",
+    DATA_DIR is None or not DATA_DIR.is_dir() or importlib.util.find_spec("rdata") is None,
+    reason="the R package's .rda files (folder named by AVAR_RDA_DIR) and rdata are not available",
 )
 
 # name -> (sensor, freq, n, gyro channels, accel channels, levels)

@@ -137,7 +137,7 @@ def noise_exponents(estimator: str, values: np.ndarray, data_type: str, rate: fl
     return alpha
 
 
-def _shared_phase_noise(estimator: str, phase: np.ndarray | OctaveMoments, drift: float,
+def _noise_of_levels(estimator: str, phase: np.ndarray | OctaveMoments, drift: float,
                         factors: np.ndarray) -> np.ndarray:
     """:func:`noise_exponents` of gap-free data from the detrended phase of the variances,
     or from the moments of the pyramid's levels."""
@@ -175,7 +175,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     if n_missing:
         alpha = noise_exponents(estimator, values, data_type, rate, factors)
     else:  # the variances' own detrended phase: no second pass over the data
-        alpha = _shared_phase_noise(estimator, phase, drift, factors)
+        alpha = _noise_of_levels(estimator, phase, drift, factors)
     edf = estimator_edf(estimator, alpha, factors, n_phase)
     if n_missing:
         edf = gap_scaled_edf(edf, n, estimator, n_phase, factors)
