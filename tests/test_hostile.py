@@ -19,8 +19,8 @@ import pandas as pd
 import pytest
 
 import avar
-from avar.cli import main
 from avar.stability.results import AllanVariance
+from tests.cli_runner import cli
 
 FMAX = np.finfo(np.float64).max
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -143,15 +143,6 @@ def data_file(tmp_path_factory) -> Path:
     pd.DataFrame({"time": np.arange(8192) / 10.0, "gx": X[:4096].repeat(2),
                   "gy": np.cumsum(X[:4096]).repeat(2)}).to_csv(path, index=False)
     return path
-
-
-def cli(capsys, *args) -> tuple[int, str, str]:
-    try:
-        code = main([str(a) for a in args])
-    except SystemExit as stop:  # argparse's own usage errors
-        code = stop.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 # (arguments with {data} = the input file and {dir} = a fresh folder, files created first, exit code,

@@ -12,18 +12,9 @@ import pytest
 distributed = pytest.importorskip("dask.distributed")
 
 from avar.cli import compute_many  # noqa: E402
-from avar.cli.main import main  # noqa: E402
+from tests.cli_runner import cli  # noqa: E402
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-
-
-def cli(capsys, *args) -> tuple[int, str, str]:
-    try:
-        code = main([str(a) for a in args])
-    except SystemExit as stop:  # argparse's own usage errors
-        code = stop.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
