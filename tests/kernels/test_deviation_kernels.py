@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 import pytest
@@ -105,3 +107,39 @@ def test_hadamard_removes_the_drift():
         variance, _ = deviation_levels(estimator, y, np.array([1, 10, 100]), "freq")
         assert np.all(variance < 1e-25), variance
     assert deviation_levels("oadev", y, np.array([1]), "freq")[0][0] == pytest.approx(0.125)
+
+
+@pytest.mark.parametrize("n", [0, 1, 3, 4, 7, 65_536, 65_539, 200_001])
+def test_scan_equals_numpy_with_gaps_and_infinities_anywhere(n):
+    rng = np.random.default_rng(n)
+    y = rng.standard_normal(n) * 1e3 + 5.0
+    for positions in ([], [0], [n - 1], [n // 2, n - 2]):
+        z = y.copy()
+        z[[p for p in positions if 0 <= p < n]] = np.nan
+        if n > 10:
+            z[n - 3] = np.inf  # in a tail, past the last group of four
+        finite = z[~np.isnan(z)]
+        count, total, low, high = scan(z)
+        assert count == np.isnan(z).sum()
+        assert low == (finite.min() if finite.size else np.inf)
+        assert high == (finite.max() if finite.size else -np.inf)
+        expected = math.fsum(finite) if np.all(np.isfinite(finite)) else np.sum(finite)
+        assert total == pytest.approx(expected, rel=1e-12, abs=1e-9)
+
+
+def test_centred_moment_equals_a_plain_loop_at_any_thread_count():
+    from avar._kernels.deviation_phase import centred_moment
+
+    rng = np.random.default_rng(3)
+    y = rng.standard_normal(150_001)
+    for kind in (0, 1):
+        count = y.size - kind
+        increments = np.diff(y) if kind else y
+        expected = math.fsum((i - (count - 1) / 2) * v for i, v in enumerate(increments))
+        bits = []
+        for threads in (1, 2):
+            numba.set_num_threads(threads)
+            bits.append(centred_moment(y, kind))
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        assert bits[0] == bits[1]
+        assert bits[0] == pytest.approx(expected, rel=1e-10)

@@ -18,6 +18,7 @@ from avar._kernels.streaming import _two_sum
 
 @njit(cache=True)
 def _scan_block(data, start, stop):
+    """NaN count, sum, min and max of ``data[start:stop]`` (the sum over the non-NaN values)."""
     count = 0
     total = 0.0
     low = np.inf
@@ -33,6 +34,32 @@ def _scan_block(data, start, stop):
     return count, total, low, high
 
 
+@njit(cache=True, fastmath={"reassoc"})
+def _scan_block_fast(data, start, stop):
+    """:func:`_scan_block` without branches, four values at a time (independent chains), exact
+    when the block has no NaN: a comparison with NaN is false, so NaN never becomes the
+    min or max, but it poisons the sum; the caller rescans such a block."""
+    count = 0
+    total = 0.0
+    l0 = l1 = l2 = l3 = np.inf
+    h0 = h1 = h2 = h3 = -np.inf
+    values = data[start:stop]  # indices from 0: no negative-index checks in the loop
+    n4 = values.shape[0] // 4 * 4
+    for i in range(0, n4, 4):
+        a, b, c, d = values[i], values[i + 1], values[i + 2], values[i + 3]
+        total += (a + b) + (c + d)
+        count += (a != a) + (b != b) + (c != c) + (d != d)
+        l0, l1, l2, l3 = a if a < l0 else l0, b if b < l1 else l1, c if c < l2 else l2, d if d < l3 else l3
+        h0, h1, h2, h3 = a if a > h0 else h0, b if b > h1 else h1, c if c > h2 else h2, d if d > h3 else h3
+    for i in range(n4, values.shape[0]):
+        v = values[i]
+        total += v
+        count += v != v
+        l0 = v if v < l0 else l0
+        h0 = v if v > h0 else h0
+    return count, total, min(min(l0, l1), min(l2, l3)), max(max(h0, h1), max(h2, h3))
+
+
 @njit(cache=True, parallel=True, nogil=True)
 def scan(data, block=CUMSUM_BLOCK):
     """Number of NaN, and sum, minimum and maximum of the other values, in one parallel pass."""
@@ -43,7 +70,10 @@ def scan(data, block=CUMSUM_BLOCK):
     lows = np.full(n_blocks, np.inf)
     highs = np.full(n_blocks, -np.inf)
     for b in prange(n_blocks):
-        nans[b], sums[b], lows[b], highs[b] = _scan_block(data, b * block, min(n, (b + 1) * block))
+        start, stop = b * block, min(n, (b + 1) * block)
+        nans[b], sums[b], lows[b], highs[b] = _scan_block_fast(data, start, stop)
+        if nans[b] > 0:
+            nans[b], sums[b], lows[b], highs[b] = _scan_block(data, start, stop)
     count = 0
     total = 0.0
     low = np.inf
@@ -124,12 +154,27 @@ def detrended_phase(data, data_lo, kind, centre, slope, scale, hi, lo, block=CUM
 
 
 @njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
-def centred_moment(data, kind):
-    """sum_i (i - (M - 1) / 2) increment_i over the M increments (``kind`` 0: ``data`` itself; 1: its differences)."""
-    count = data.shape[0] - kind
-    half = (count - 1) / 2.0
+def _centred_moment_block(data, kind, start, stop, half):
     total = 0.0
-    for i in range(count):
+    for i in range(start, stop):
         v = data[i + 1] - data[i] if kind == 1 else data[i]
         total += (i - half) * v
+    return total
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def centred_moment(data, kind, block=CUMSUM_BLOCK):
+    """sum_i (i - (M - 1) / 2) increment_i over the M increments (``kind`` 0: ``data`` itself; 1: its differences).
+
+    Blocks in parallel, added in order: the bits do not depend on the thread count.
+    """
+    count = data.shape[0] - kind
+    half = (count - 1) / 2.0
+    n_blocks = (count + block - 1) // block
+    parts = np.zeros(max(n_blocks, 1))
+    for b in prange(n_blocks):
+        parts[b] = _centred_moment_block(data, kind, b * block, min(count, (b + 1) * block), half)
+    total = 0.0
+    for b in range(n_blocks):
+        total += parts[b]
     return total
