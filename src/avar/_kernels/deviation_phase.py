@@ -155,10 +155,13 @@ def detrended_phase(data, data_lo, kind, centre, slope, scale, hi, lo, block=CUM
 
 @njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
 def _centred_moment_block(data, kind, start, stop, half):
+    """sum over the increments ``start <= i < stop`` of (i - half) increment_i."""
+    values = data[start : stop + kind]  # indices from 0: no negative-index checks in the loop
+    origin = start - half
     total = 0.0
-    for i in range(start, stop):
-        v = data[i + 1] - data[i] if kind == 1 else data[i]
-        total += (i - half) * v
+    for i in range(stop - start):
+        v = values[i + 1] - values[i] if kind == 1 else values[i]
+        total += (origin + i) * v
     return total
 
 
