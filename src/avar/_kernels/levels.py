@@ -67,7 +67,7 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
                     where = 0 if used != 0 else 1
                     q = p // block
                     fill_prefix(data, col, q * block, p + cnt - 1, centre, scale, th[col, q], tl[col, q],
-                                rh[where], rl[where], 0, unused)
+                                rh[where], rl[where], 0, unused, False)
                     rs[where] = q * block
                     re_[where] = p + cnt - 1
                 if where >= 0:
@@ -109,13 +109,13 @@ def to_task(data, col, kb0, kb1, centre, scale, th, tl, factors, clusters, out_r
             have[k] = 2
     bh = np.empty(block + 1)
     bl = np.empty(block + 1)
-    unused = np.zeros(2)  # fill_prefix's magnitudes, not needed here
+    unused = np.zeros(2)  # fill_prefix's magnitudes: not tracked here
     for kb in range(kb0, kb1):
         t0 = kb * block
         if t0 >= last_pos:
             break
         stop = min(n, t0 + block, last_pos)
-        fill_prefix(data, col, t0, stop, centre, scale, th[col, kb], tl[col, kb], bh, bl, 0, unused)
+        fill_prefix(data, col, t0, stop, centre, scale, th[col, kb], tl[col, kb], bh, bl, 0, unused, False)
         for k in range(n_levels):
             m = factors[k]
             e = (t0 // m + 1) * m

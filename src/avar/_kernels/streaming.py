@@ -191,12 +191,15 @@ def _finish_table(bh, bl, bm, n, block, integral):
 
 
 @njit(cache=True)
-def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at, bounds):
+def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at, bounds, track=True):
     """``out[at + i] = S[start + i]`` for ``i = 0 .. stop - start`` from ``S[start] = (s_hi, s_lo)``.
 
     Stored renormalized (``out_hi`` is ``S`` rounded to float64, ``out_lo`` the
     rest), so that :func:`certified_squares` can use ``out_hi`` alone; ``bounds``
     is raised to the largest ``|out_hi|`` and ``|out_lo|`` written (see :func:`magnitudes`).
+    With ``track=False`` (prefixes that only :func:`squares` reads) the pair is
+    stored as the running sum and its compensation, not renormalized, and
+    ``bounds`` is left alone: two operations less per sample.
 
     (Loops run over slices with ``range(count)``: non-negative indices, so
     numba emits no wraparound checks and LLVM can vectorize the loads.)
@@ -209,6 +212,14 @@ def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_l
     comp = s_lo
     out_hi[at] = total
     out_lo[at] = comp
+    if not track:
+        for i in range(count):
+            yh, yl = _centred(x[i], centre, scale)
+            total, e = _two_sum(total, yh)
+            comp += e + yl
+            oh[i] = total
+            ol[i] = comp
+        return
     big_h = max(bounds[0], abs(total))
     big_l = max(bounds[1], abs(comp))
     for i in range(count):
