@@ -204,3 +204,45 @@ def test_small_path_on_threads_is_exact_and_thread_independent(name):
         numba.set_num_threads(threads)
     picks = factors[[0, 5, -1]]
     np.testing.assert_allclose(got[[0, 5, -1]], exact(x, picks, "mo"), rtol=1e-10)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32, np.int64, np.int16])
+@pytest.mark.parametrize("count", [1, 5, 31, 32, 100, 1000])
+def test_sweep_steps_and_chained_squares_match_exact_arithmetic(dtype, count):
+    """The sweep's large levels: steps ``x[t+2m] - 2 x[t+m] + x[t]`` rounded once, and the sum of
+    the squares of the running ``D`` they drive (started from an exact ``D_0``), against
+    Fractions, on an offset far above the noise (where a prefix-sum method would cancel)."""
+    from avar._kernels.sweep import chained_squares, second_differences
+
+    rng = np.random.default_rng(count)
+    n, m, t0 = 3 * 4096, 1024, 37
+    if np.dtype(dtype).kind == "f":
+        x = (1e6 + rng.standard_normal(n)).astype(dtype)
+    else:
+        info = np.iinfo(dtype)
+        x = rng.integers(info.min // 2, info.max // 2, size=n, dtype=dtype)
+    data = x[:, None]
+    steps = np.full(count, np.nan)
+    second_differences(data.T, 0, t0, m, count, 1.0, steps)
+    v = [Fraction(int(a)) if np.dtype(dtype).kind == "i" else Fraction(float(a)) for a in x]
+    exact_steps = [v[t0 + i + 2 * m] - 2 * v[t0 + i + m] + v[t0 + i] for i in range(count - 1)]
+    np.testing.assert_allclose(steps[: count - 1], [float(g) for g in exact_steps], rtol=2**-52, atol=0)
+    assert steps[count - 1] == 0.0
+    d0 = sum(v[t0 + 2 * m - j] for j in range(1, m + 1)) - sum(v[t0 + m - j] for j in range(1, m + 1))
+    d, want = d0, Fraction(0)
+    for i in range(count):
+        want += d * d
+        d += exact_steps[i] if i < count - 1 else 0
+    got = chained_squares(float(d0), steps, count)
+    assert got == pytest.approx(float(want), rel=1e-12)
+
+
+def test_second_differences_scale_extreme_samples_before_rounding():
+    from avar._kernels.sweep import second_differences
+
+    x = np.array([1e300, -1e300, 1e300, 3e300, -1e300, 2e300])[:, None]
+    steps = np.empty(3)
+    second_differences(x.T, 0, 0, 1, 3, 2.0**-1000, steps)
+    want = [(x[i + 2, 0] * 2.0**-1000 - 2 * x[i + 1, 0] * 2.0**-1000 + x[i, 0] * 2.0**-1000) for i in range(2)]
+    np.testing.assert_allclose(steps[:2], want, rtol=1e-15)
+    assert np.isfinite(steps).all()

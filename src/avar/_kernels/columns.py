@@ -100,7 +100,7 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
     chunk = _chunk(n_diff[0], block, SWEEP_CHUNK) if chunk is None else chunk
     th, tl, centre, scale = _table(data, block)
     n_small = int(np.searchsorted(factors, max(near, block)))
-    sums = sweep_sums(data, centre, scale, th, tl, factors, n_diff, n_small, block, chunk)
+    sums = sweep_sums(data, data.T, centre, scale, th, tl, factors, n_diff, n_small, block, chunk)
     return _finish(sums, scale, factors, n_diff.astype(np.float64))
 
 

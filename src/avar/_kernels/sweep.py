@@ -7,18 +7,19 @@ for each block, serves every level:
 
 * small levels (``m < SWEEP_NEAR``) from one sliding window of the centred
   ``S`` (block plus a halo of ``2 m``), computed once per sample;
-* large levels (``m`` a multiple of the block) from *regions*: the block
-  itself and the blocks ``m`` and ``2 m`` later. Each region gets a local
-  compensated prefix of the raw samples ``L(i)``, and
+* large levels (``m`` a multiple of the block) from the recurrence
 
-      D_{t0+i} = C + (L_2m(i) - 2 L_m(i) + L_0(i)),
-      C = S[t0+2m] - 2 S[t0+m] + S[t0]   (double-double, from the block table)
+      D_{t0} = S[t0+2m] - 2 S[t0+m] + S[t0]   (exact double-double, from the block table)
+      D_{t+1} = D_t + (x[t+2m] - 2 x[t+m] + x[t])
 
-  (the centring term ``i * centre`` cancels exactly in the second
-  difference, so the regions need no centring). For octave grids the ``2 m``
-  region of one level is the ``m`` region of the next, so each large level
-  costs one region prefix: about one read of the input per level, each
-  region loaded into the cache once per block.
+  Each step is rounded once (:func:`second_differences`, TwoSum), and the
+  running value is ``D`` itself, never a cumulative sum, so every addition
+  errs by at most ``u |D|``: over a block of ``B`` samples each ``D`` errs by
+  at most about ``B u (max |D| + sum |steps|)`` (``B u`` = 1e-12 for the
+  default block), whatever the offset or the excursion of ``S``.
+  :func:`chained_squares` runs the block as :data:`CHAINS` independent
+  stretches so the additions do not wait on one another. A level reads three
+  streams of the input once, about one read of the input per level.
 
 The block table (exact double-double ``S`` at every block boundary) comes
 from :func:`avar._kernels.streaming.block_table`; the sums of every task are
@@ -32,7 +33,7 @@ from numba import njit, prange, types
 from numba.extending import overload
 
 from avar._kernels.haar import _pair
-from avar._kernels.streaming import _fast_sum, _two_sum, window_level_sums
+from avar._kernels.streaming import _two_sum, window_level_sums
 
 #: Samples per block (region alignment, table granularity).
 SWEEP_BLOCK = 1 << 13
@@ -45,64 +46,124 @@ SWEEP_NEAR = 1 << 15
 SWEEP_CHUNK = 32
 
 
-def _add_raw(total, comp, x, sc):  # pragma: no cover - replaced by the overload in compiled code
+def _second_difference(x2, x1, x0, sc):  # pragma: no cover - replaced by the overload in compiled code
     raise NotImplementedError
 
 
-@overload(_add_raw, inline="always")
-def _add_raw_overload(total, comp, x, sc):
-    """``(total, comp) + x * sc`` compensated (64-bit integers enter as two exact halves)."""
-    if isinstance(x, types.Integer) and x.bitwidth == 64:
+@overload(_second_difference, inline="always")
+def _second_difference_overload(x2, x1, x0, sc):
+    """``(x2 - 2 x1 + x0) * sc`` rounded once (TwoSum; 64-bit integers enter as two exact halves)."""
+    if isinstance(x2, types.Integer) and x2.bitwidth == 64:
 
-        def impl(total, comp, x, sc):
-            a, b = _pair(x, sc)
-            total, e = _two_sum(total, a)
-            return total, comp + (e + b)
+        def impl(x2, x1, x0, sc):
+            h2, l2 = _pair(x2, sc)
+            h1, l1 = _pair(x1, sc)
+            h0, l0 = _pair(x0, sc)
+            a, ea = _two_sum(h2, h0)
+            b, eb = _two_sum(a, -2.0 * h1)
+            return b + ((ea + eb) + ((l2 + l0) - 2.0 * l1))
 
         return impl
 
-    def impl(total, comp, x, sc):
-        total, e = _two_sum(total, np.float64(x) * sc)
-        return total, comp + e
+    def impl(x2, x1, x0, sc):
+        a, ea = _two_sum(np.float64(x2) * sc, np.float64(x0) * sc)
+        b, eb = _two_sum(a, -2.0 * (np.float64(x1) * sc))
+        return b + (ea + eb)
 
     return impl
 
 
 @njit(cache=True)
-def raw_prefix(data, col, start, count, sc, oh, ol):
-    """``oh/ol[i]`` = compensated sum of ``data[start:start+i, col] * sc``, ``i < count``."""
-    x = data[start : start + count - 1, col]
-    h = oh[1:count]
-    l = ol[1:count]
-    oh[0] = 0.0
-    ol[0] = 0.0
-    total = 0.0
-    comp = 0.0
-    if sc == 1.0:  # the usual case: the product folds away
+def second_differences(rows, col, t0, m, count, sc, out):
+    """``out[i] = (x[t0+i+2m] - 2 x[t0+i+m] + x[t0+i]) * sc`` for ``i < count - 1``; ``out[count - 1] = 0``.
+
+    These are the steps ``D_{t+1} - D_t`` of the level-``m`` differences (the centre
+    cancels). Each is rounded once, so it errs by at most ``u |step|`` (u = 2**-53)
+    plus ``u**2`` of the samples' magnitude. Elementwise: LLVM vectorizes it.
+    """
+    x0 = rows[col, t0 : t0 + count - 1]
+    x1 = rows[col, t0 + m : t0 + m + count - 1]
+    x2 = rows[col, t0 + 2 * m : t0 + 2 * m + count - 1]
+    g = out[: count - 1]
+    if sc == 1.0:  # the usual case: the products fold away
         for i in range(count - 1):
-            total, comp = _add_raw(total, comp, x[i], 1.0)
-            h[i] = total
-            l[i] = comp
+            g[i] = _second_difference(x2[i], x1[i], x0[i], 1.0)
     else:
         for i in range(count - 1):
-            total, comp = _add_raw(total, comp, x[i], sc)
-            h[i] = total
-            l[i] = comp
+            g[i] = _second_difference(x2[i], x1[i], x0[i], sc)
+    out[count - 1] = 0.0
+
+
+#: Independent running sums of :func:`chained_squares` (they hide the latency of the adds).
+CHAINS = 8
+
+
+@njit(cache=True, fastmath={"reassoc", "contract"})
+def _plain_sum(g, lo, hi):
+    total = 0.0
+    x = g[lo:hi]
+    for i in range(hi - lo):
+        total += x[i]
+    return total
 
 
 @njit(cache=True)
-def based_squares(ch, cl, h0, l0, h1, l1, h2, l2, count, buffer):
-    """Sum over ``i < count`` of ``(C + L2(i) - 2 L1(i) + L0(i))**2``, all compensated."""
-    x0 = h0[:count]
-    x1 = h1[:count]
-    x2 = h2[:count]
-    y0 = l0[:count]
-    y1 = l1[:count]
-    y2 = l2[:count]
-    for i in range(count):
-        d = (ch + ((x2[i] - x1[i]) - (x1[i] - x0[i]))) + (cl + ((y2[i] - y1[i]) - (y1[i] - y0[i])))
-        buffer[i] = d * d
-    return _fast_sum(buffer, count)
+def chained_squares(start, steps, count):
+    """Sum over ``i < count`` of ``D_i**2`` where ``D_0 = start`` and ``D_{i+1} = D_i + steps[i]``.
+
+    The running value is ``D`` itself, so each addition errs by at most ``u |D|``: the
+    sum errs by at most ``2 count u`` relative, however large the samples or the
+    cumulative sum. The block runs as :data:`CHAINS` stretches whose starting values
+    come from the stretches' plain sums of steps, so the additions do not wait for one
+    another (a single running sum is bound by the latency of one add per sample).
+    """
+    q = count // CHAINS
+    if q < 4:
+        d = start
+        total = 0.0
+        for i in range(count):
+            total += d * d
+            d += steps[i]
+        return total
+    d0 = start
+    d1 = d0 + _plain_sum(steps, 0, q)
+    d2 = d1 + _plain_sum(steps, q, 2 * q)
+    d3 = d2 + _plain_sum(steps, 2 * q, 3 * q)
+    d4 = d3 + _plain_sum(steps, 3 * q, 4 * q)
+    d5 = d4 + _plain_sum(steps, 4 * q, 5 * q)
+    d6 = d5 + _plain_sum(steps, 5 * q, 6 * q)
+    d7 = d6 + _plain_sum(steps, 6 * q, 7 * q)
+    s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = 0.0
+    g0 = steps[0:q]
+    g1 = steps[q : 2 * q]
+    g2 = steps[2 * q : 3 * q]
+    g3 = steps[3 * q : 4 * q]
+    g4 = steps[4 * q : 5 * q]
+    g5 = steps[5 * q : 6 * q]
+    g6 = steps[6 * q : 7 * q]
+    g7 = steps[7 * q : 8 * q]
+    for i in range(q):
+        s0 += d0 * d0
+        d0 += g0[i]
+        s1 += d1 * d1
+        d1 += g1[i]
+        s2 += d2 * d2
+        d2 += g2[i]
+        s3 += d3 * d3
+        d3 += g3[i]
+        s4 += d4 * d4
+        d4 += g4[i]
+        s5 += d5 * d5
+        d5 += g5[i]
+        s6 += d6 * d6
+        d6 += g6[i]
+        s7 += d7 * d7
+        d7 += g7[i]
+    rest = steps[8 * q : count]
+    for i in range(count - 8 * q):
+        s7 += d7 * d7
+        d7 += rest[i]
+    return ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))
 
 
 @njit(cache=True, inline="always")
@@ -114,7 +175,7 @@ def _base(th, tl, col, k0, k1, k2):
 
 
 @njit(cache=True)
-def sweep_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, n_small, out_row, block):
+def sweep_task(data, rows, col, kb0, kb1, centre, scale, th, tl, factors, nd, n_small, out_row, block):
     """Sums of ``D**2`` of every level for the differences starting in blocks ``kb0 .. kb1 - 1``."""
     n = data.shape[0]
     n_levels = factors.shape[0]
@@ -122,8 +183,7 @@ def sweep_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, n_small,
     cap = 2 * (block + halo) + 1
     wh = np.empty(cap)
     wl = np.empty(cap)
-    rh = np.empty((3, block))
-    rl = np.empty((3, block))
+    steps = np.empty(block)
     buffer = np.empty(block)
     bounds = np.zeros(2)  # largest |S| hi and lo parts the window has held
     w0 = kb0 * block
@@ -141,28 +201,20 @@ def sweep_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, n_small,
                                            filled, factors, nd, n_small, block, out_row, buffer, bounds)
         if n_small == n_levels or nd[n_small] <= t0:
             continue
-        # large levels: region 0 (this block), then the m and 2m regions level by level
-        raw_prefix(data, col, t0, min(block, nd[n_small] - t0), scale, rh[0], rl[0])
-        mid = 1
-        held = -1  # offset (in blocks) of the region in rh[mid]
+        # large levels: D at the block start from the table, then its steps
         for k in range(n_small, n_levels):
             cnt = min(block, nd[k] - t0)
             if cnt <= 0:
                 break
             o = factors[k] // block
-            if held != o:  # not the 2m region of the level before (a grid with gaps)
-                raw_prefix(data, col, t0 + o * block, cnt, scale, rh[mid], rl[mid])
-            far = 3 - mid
-            raw_prefix(data, col, t0 + 2 * o * block, cnt, scale, rh[far], rl[far])
+            second_differences(rows, col, t0, factors[k], cnt, scale, steps)
             ch, cl = _base(th, tl, col, kb, kb + o, kb + 2 * o)
-            out_row[k] += based_squares(ch, cl, rh[0], rl[0], rh[mid], rl[mid], rh[far], rl[far], cnt, buffer)
-            mid = far
-            held = 2 * o
+            out_row[k] += chained_squares(ch + cl, steps, cnt)
     return out_row
 
 
 @njit(cache=True, parallel=True)
-def sweep_sums(data, centre, scale, th, tl, factors, nd, n_small, block, chunk):
+def sweep_sums(data, rows, centre, scale, th, tl, factors, nd, n_small, block, chunk):
     """Sums of ``D**2`` per (column, level), shape (C, L).
 
     ``factors`` strictly increasing, those from index ``n_small`` on multiples
@@ -176,7 +228,7 @@ def sweep_sums(data, centre, scale, th, tl, factors, nd, n_small, block, chunk):
     for task in prange(channels * n_chunks):
         c = task // n_chunks
         j = task % n_chunks
-        sweep_task(data, c, j * chunk, min(n_blocks, (j + 1) * chunk), centre[c], scale[c], th, tl, factors, nd,
+        sweep_task(data, rows, c, j * chunk, min(n_blocks, (j + 1) * chunk), centre[c], scale[c], th, tl, factors, nd,
                    n_small, out[c, j], block)
     result = np.zeros((channels, factors.shape[0]))
     for c in range(channels):
