@@ -33,7 +33,13 @@ def test_detrended_phase_is_the_exact_running_sum():
 
 def test_scan():
     data = np.array([1.0, np.nan, -3.0, 5.0, np.nan])
-    assert scan(data, block=2) == (2, 3.0, -3.0, 5.0)
+    assert scan(data, block=2)[:4] == (2, 3.0, -3.0, 5.0)
+    assert np.isnan(scan(data, block=2, weigh=True)[4])  # no moment with a NaN
+    clean = np.array([1.0, 2.0, -3.0, 5.0, 7.0, 0.5, 4.0])
+    assert np.isnan(scan(clean)[4])  # not asked for
+    for block in (2, 5, 8192):  # the 4-wide loop, its tail, block seams
+        moment = scan(clean, block=block, weigh=True)[4]
+        assert moment == pytest.approx(sum((i - 3.0) * v for i, v in enumerate(clean)), rel=1e-15)
 
 
 def plain_loop(code, hi, lo, m, stride, first, last):
@@ -119,12 +125,16 @@ def test_scan_equals_numpy_with_gaps_and_infinities_anywhere(n):
         if n > 10:
             z[n - 3] = np.inf  # in a tail, past the last group of four
         finite = z[~np.isnan(z)]
-        count, total, low, high = scan(z)
+        count, total, low, high, moment = scan(z)
         assert count == np.isnan(z).sum()
         assert low == (finite.min() if finite.size else np.inf)
         assert high == (finite.max() if finite.size else -np.inf)
         expected = math.fsum(finite) if np.all(np.isfinite(finite)) else np.sum(finite)
         assert total == pytest.approx(expected, rel=1e-12, abs=1e-9)
+    if n:  # gap-free: the centred moment of the Hadamard family's drift (scale: n^2 / 2 * 1e3)
+        moment = scan(y, weigh=True)[4]
+        assert moment == pytest.approx(math.fsum((i - (n - 1) / 2) * v for i, v in enumerate(y)),
+                                       rel=1e-12, abs=1e-12 * n * n * 1e3)
 
 
 def test_centred_moment_equals_a_plain_loop_at_any_thread_count():

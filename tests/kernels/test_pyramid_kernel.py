@@ -189,3 +189,36 @@ def test_r_n_from_clusters_never_builds_the_phase():
             np.testing.assert_array_equal(got, phase_noise(moments.phase(), factors, dmax, drift, line_free=True))
             built += len(calls)
     assert built == 0
+
+
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("count", [128, 511, 1024, 1537])
+def test_array_chunk_equals_its_plain_twin(order, count):
+    """:func:`_chunk_fast` (array by array, in pieces) carries a level's state as the
+    one-cluster-at-a-time :func:`_chunk_body` does: the same pair sums and last clusters
+    bit for bit, the same moments to rounding, on double-double clusters over an offset."""
+    from avar._kernels.pyramid import PIECE, STATE, _chunk_body, _chunk_fast, _start
+
+    rng = np.random.default_rng(count + order)
+    first = 7  # clusters the plain twin takes first (a stretch's start is always plain)
+    hi = 1e6 + rng.standard_normal(first + count)
+    lo = rng.standard_normal(first + count) * 1e-11
+    state = np.zeros(STATE)
+    _start(state, first + count + 10, 0, 0.25)
+    head_hi, head_lo = np.empty(first), np.empty(first)
+    _chunk_body(hi[:first], lo[:first], order, first, 0, state, head_hi, head_lo, np.empty(0), 0)
+    plain, fast = state.copy(), state.copy()
+    pairs_plain = np.full((2, count // 2), np.nan)
+    _chunk_body(hi[first:], lo[first:], order, count, first + 1, plain, pairs_plain[0], pairs_plain[1],
+                np.empty(0), 0)
+    hh, ll = np.r_[np.zeros(3), hi[first:]], np.r_[np.zeros(3), lo[first:]]
+    dst_hh, dst_ll = np.full(count + 3, np.nan), np.full(count + 3, np.nan)
+    work = [np.empty(PIECE + 1) for _ in range(5)]
+    _chunk_fast(hh, ll, order, count, fast, dst_hh, dst_ll, *work)
+    np.testing.assert_array_equal(dst_hh[3 : 3 + count // 2], pairs_plain[0])
+    np.testing.assert_array_equal(dst_ll[3 : 3 + count // 2], pairs_plain[1])
+    exact_fields = [9, 10, 11, 12, 13, 14, 19]  # last three clusters, centred index
+    np.testing.assert_array_equal(fast[exact_fields], plain[exact_fields])
+    sums = [0, 1, 2, 3, 4, 5, 6, 7, 8, 15, 16]  # running moments, last differences
+    np.testing.assert_allclose(fast[sums], plain[sums], rtol=1e-12, atol=0)
+    assert plain[6] > 0 and plain[7] > 0 and (order == 1 or plain[8] > 0)

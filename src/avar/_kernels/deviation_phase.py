@@ -35,12 +35,14 @@ def _scan_block(data, start, stop):
 
 
 @njit(cache=True, fastmath={"reassoc"})
-def _scan_block_fast(data, start, stop):
+def _scan_block_fast(data, start, stop, weigh):
     """:func:`_scan_block` without branches, four values at a time (independent chains), exact
     when the block has no NaN: a comparison with NaN is false, so NaN never becomes the
-    min or max, but it poisons the sum; the caller rescans such a block."""
+    min or max, but it poisons the sum; the caller rescans such a block. With ``weigh``,
+    also ``sum_i i data[start + i]`` (the block's index-weighted sum; 0.0 otherwise)."""
     count = 0
     total = 0.0
+    weighted = 0.0
     l0 = l1 = l2 = l3 = np.inf
     h0 = h1 = h2 = h3 = -np.inf
     values = data[start:stop]  # indices from 0: no negative-index checks in the loop
@@ -48,42 +50,52 @@ def _scan_block_fast(data, start, stop):
     for i in range(0, n4, 4):
         a, b, c, d = values[i], values[i + 1], values[i + 2], values[i + 3]
         total += (a + b) + (c + d)
+        if weigh:  # i a + (i + 1) b + (i + 2) c + (i + 3) d
+            weighted += np.float64(i) * ((a + b) + (c + d)) + ((b + d) + 2.0 * (c + d))
         count += (a != a) + (b != b) + (c != c) + (d != d)
         l0, l1, l2, l3 = a if a < l0 else l0, b if b < l1 else l1, c if c < l2 else l2, d if d < l3 else l3
         h0, h1, h2, h3 = a if a > h0 else h0, b if b > h1 else h1, c if c > h2 else h2, d if d > h3 else h3
     for i in range(n4, values.shape[0]):
         v = values[i]
         total += v
+        weighted += np.float64(i) * v
         count += v != v
         l0 = v if v < l0 else l0
         h0 = v if v > h0 else h0
-    return count, total, min(min(l0, l1), min(l2, l3)), max(max(h0, h1), max(h2, h3))
+    return count, total, min(min(l0, l1), min(l2, l3)), max(max(h0, h1), max(h2, h3)), weighted
 
 
 @njit(cache=True, parallel=True, nogil=True)
-def scan(data, block=CUMSUM_BLOCK):
-    """Number of NaN, and sum, minimum and maximum of the other values, in one parallel pass."""
+def scan(data, block=CUMSUM_BLOCK, weigh=False):
+    """Number of NaN, and sum, minimum and maximum of the other values, in one parallel pass;
+    with ``weigh`` and no NaN, also the centred moment ``sum_i (i - (N - 1) / 2) data_i``
+    (the numerator of the least-squares slope; NaN otherwise)."""
     n = data.shape[0]
     n_blocks = (n + block - 1) // block
     nans = np.zeros(n_blocks, dtype=np.int64)
     sums = np.zeros(n_blocks)
     lows = np.full(n_blocks, np.inf)
     highs = np.full(n_blocks, -np.inf)
+    moments = np.zeros(n_blocks)
+    half = (n - 1) / 2.0
     for b in prange(n_blocks):
         start, stop = b * block, min(n, (b + 1) * block)
-        nans[b], sums[b], lows[b], highs[b] = _scan_block_fast(data, start, stop)
+        nans[b], sums[b], lows[b], highs[b], weighted = _scan_block_fast(data, start, stop, weigh)
+        moments[b] = weighted + (start - half) * sums[b]
         if nans[b] > 0:
             nans[b], sums[b], lows[b], highs[b] = _scan_block(data, start, stop)
     count = 0
     total = 0.0
     low = np.inf
     high = -np.inf
+    moment = 0.0
     for b in range(n_blocks):  # in order: the result does not depend on the thread count
         count += nans[b]
         total += sums[b]
         low = min(low, lows[b])
         high = max(high, highs[b])
-    return count, total, low, high
+        moment += moments[b]
+    return count, total, low, high, moment if count == 0 and weigh else np.nan
 
 
 @njit(cache=True, inline="always")

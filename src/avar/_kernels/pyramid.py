@@ -21,10 +21,14 @@ at most :data:`TAIL` clusters also hand back their cluster sums (Barnes's B1
 ratio needs the few decimated points).
 
 The lower levels go block by block (2**:data:`BLOCK_EXP` samples): a block's
-pyramid lives in a buffer of half a block and each level carries its running
-state (:data:`STATE`) from block to block, so the workspace is a few
+pyramid lives in two buffers of a block and each level carries its running
+state (:data:`STATE`) from block to block, so the workspace is some
 kilobytes plus one value per block, never O(N) fresh memory (whose first-touch
-page faults cost more than the arithmetic). A long series runs as two
+page faults cost more than the arithmetic). A level's chunk goes array by
+array (:func:`_chunk_fast`: exact differences and pair sums elementwise, the
+phase as one running sum, the moments as vectorized plain sums) in pieces
+that stay in the L1 cache; a stretch's first clusters and short chunks go one
+cluster at a time (:func:`_chunk_body`, its plain twin, which the tests compare). A long series runs as two
 stretches on two threads, cut at a block boundary fixed by N: the bits do not
 depend on the thread count. The tests compare the sums with the general
 kernels of :mod:`avar._kernels.deviations` and with exact arithmetic, the
@@ -66,18 +70,11 @@ BLOCK_EXP = 12
 SPLIT_BLOCKS = 8
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _value(y, start, centre, slope, scale, src_hi, src_lo, first_level, j):
-    """Cluster j of a chunk: level 1's from ``y[start + j]``, the others' from ``src_hi/lo``."""
-    if first_level:
-        return _increment(y, _NO_LO, start + j, 0, centre, slope, scale)
-    return src_hi[j], src_lo[j]
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _chunk_body(y, start, centre, slope, scale, src_hi, src_lo, first_level, order, count, j0, state, dst_hi, dst_lo,
-                tail, k0):
-    """Carry one level of a stretch over its next ``count`` clusters (stretch indices ``j0 ..``).
+@njit(cache=True, nogil=True)
+def _chunk_body(src_hi, src_lo, order, count, j0, state, dst_hi, dst_lo, tail, k0):
+    """Carry one level of a stretch over its next ``count`` clusters ``src_hi/lo[:count]``
+    (stretch indices ``j0 ..``), one cluster at a time: the plain twin of :func:`_chunk_fast`,
+    and the path of a stretch's first clusters and of the levels that keep a ``tail``.
 
     ``state`` (:data:`STATE` values) holds the running moments, the last three
     and the first three clusters. The sum of the estimator's own ``order``-th
@@ -92,7 +89,7 @@ def _chunk_body(y, start, centre, slope, scale, src_hi, src_lo, first_level, ord
     pd1, pd2, d1_first, d2_first, t = state[_PD1], state[_PD2], state[_D1F], state[_D2F], state[_T]
     keep = tail.shape[0] > 0
     for j in range(count):
-        h, l = _value(y, start, centre, slope, scale, src_hi, src_lo, first_level, j)
+        h, l = src_hi[j], src_lo[j]
         jj = j0 + j
         v = h + l
         z += v
@@ -137,46 +134,156 @@ def _chunk_body(y, start, centre, slope, scale, src_hi, src_lo, first_level, ord
 
 
 @njit(cache=True, nogil=True)
-def _first_chunk(y, start, centre, slope, scale, order, count, j0, state, dst_hi, dst_lo, tail, k0):
-    """:func:`_chunk_body` of level 1 (the values from ``y[start:]``)."""
-    _chunk_body(y, start, centre, slope, scale, dst_hi, dst_lo, True, order, count, j0, state, dst_hi, dst_lo, tail,
-                k0)
+def _increments(y, start, count, centre, slope, scale, hh, ll):
+    """Level 1's clusters ``(y[start + j] - centre - slope (start + j)) scale`` into ``hh/ll[3 : 3 + count]``."""
+    for j in range(count):
+        hh[3 + j], ll[3 + j] = _increment(y, _NO_LO, start + j, 0, centre, slope, scale)
 
 
 @njit(cache=True, nogil=True)
-def _upper_chunk(src_hi, src_lo, order, count, j0, state, dst_hi, dst_lo, tail, k0):
-    """:func:`_chunk_body` of a level from the cluster sums ``src_hi/lo``."""
-    _chunk_body(src_hi, 0, 0.0, 0.0, 1.0, src_hi, src_lo, False, order, count, j0, state, dst_hi, dst_lo, tail, k0)
+def _terms(hh, ll, count, order, v, d1, d2, d3, pair_hi, pair_lo):
+    """The values, differences and pair sums of a chunk (clusters at ``hh/ll[3 :]``, the
+    three before them at ``hh/ll[:3]``), elementwise (vectorized; no reassociation, so the
+    double-double differences stay exact): the values ``v``, the differences ``d1`` (from
+    the previous cluster on: count + 1), ``d2``, ``d3`` (order 2); the pair sums go to
+    ``pair_hi/lo[3 :]``."""
+    d1[0] = (hh[2] - hh[1]) + (ll[2] - ll[1])
+    if order == 1:
+        for j in range(count):
+            h, l, h1, l1 = hh[3 + j], ll[3 + j], hh[2 + j], ll[2 + j]
+            v[j] = h + l
+            d1[j + 1] = (h - h1) + (l - l1)
+            d2[j] = d1[j + 1] - ((h1 - hh[1 + j]) + (l1 - ll[1 + j]))
+    else:
+        for j in range(count):
+            h, l, h1, l1 = hh[3 + j], ll[3 + j], hh[2 + j], ll[2 + j]
+            h2, l2, h3, l3 = hh[1 + j], ll[1 + j], hh[j], ll[j]
+            v[j] = h + l
+            d1[j + 1] = (h - h1) + (l - l1)
+            d2[j] = ((h - h1) - (h1 - h2)) + ((l - l1) - (l1 - l2))
+            d3[j] = d2[j] - (((h1 - h2) - (h2 - h3)) + ((l1 - l2) - (l2 - l3)))
+    for i in range(count // 2):
+        s, e = _two_sum(hh[3 + 2 * i], hh[4 + 2 * i])
+        pair_hi[3 + i] = s
+        pair_lo[3 + i] = (ll[3 + 2 * i] + ll[4 + 2 * i]) + e
+
+
+@njit(cache=True, nogil=True)
+def _running(v, count, z0, z):
+    """The phase after each value: ``z[j] = z0 + v[0] + ... + v[j]`` (plain, as :func:`_chunk_body`)."""
+    total = z0
+    for j in range(count):
+        total += v[j]
+        z[j] = total
+
+
+@njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
+def _sums(z, v, d1, d2, d3, count, t0, order):
+    """The chunk's moments (plain sums, vectorized): z, t z, t^2 z, z^2, v^2, d1^2, d2^2, d3^2."""
+    s0 = s1 = s2 = q0 = vs = e1 = e2 = e3 = 0.0
+    for j in range(count):
+        zj = z[j]
+        tj = t0 + j
+        s0 += zj
+        s1 += tj * zj
+        s2 += (tj * tj) * zj
+        q0 += zj * zj
+        vs += v[j] * v[j]
+        e1 += d1[j + 1] * d1[j + 1]
+        e2 += d2[j] * d2[j]
+    if order == 2:
+        for j in range(count):
+            e3 += d3[j] * d3[j]
+    return s0, s1, s2, q0, vs, e1, e2, e3
+
+
+#: Chunks of at least this many clusters (past a stretch's first three) take :func:`_chunk_fast`.
+FAST_MIN = 128
+#: Clusters per piece of :func:`_chunk_fast` (even): its work arrays stay in the L1 cache.
+PIECE = 512
+
+
+@njit(cache=True, nogil=True)
+def _chunk_fast(hh, ll, order, count, state, dst_hh, dst_ll, v, d1, d2, d3, z):
+    """:func:`_chunk_body` of a chunk past the stretch's first three clusters, without a tail,
+    array by array in pieces of :data:`PIECE` (the clusters at ``hh/ll[3 :]``; the pair sums
+    to ``dst_hh/dst_ll[3 :]``; ``v, d1, d2, d3, z``: work arrays of ``PIECE + 1``)."""
+    hh[0], hh[1], hh[2] = state[_P3H], state[_PPH], state[_PH]
+    ll[0], ll[1], ll[2] = state[_P3L], state[_PPL], state[_PL]
+    running = state[_Z]
+    t = state[_T]
+    s0 = s1 = s2 = q0 = vs = e1 = e2 = e3 = 0.0
+    size = 0
+    for start in range(0, count, PIECE):
+        size = min(PIECE, count - start)
+        half = start // 2
+        _terms(hh[start:], ll[start:], size, order, v, d1, d2, d3, dst_hh[half:], dst_ll[half:])
+        _running(v, size, running, z)
+        running = z[size - 1]
+        a0, a1, a2, a3, a4, a5, a6, a7 = _sums(z, v, d1, d2, d3, size, t + start, order)
+        s0 += a0
+        s1 += a1
+        s2 += a2
+        q0 += a3
+        vs += a4
+        e1 += a5
+        e2 += a6
+        e3 += a7
+    state[_S0] += s0
+    state[_S1] += s1
+    state[_S2] += s2
+    state[_Q0] += q0
+    state[_VSQ] += vs
+    state[_E1] += e1
+    state[_E2] += e2
+    state[_E3] += e3
+    state[_Z] = running
+    state[_T] = t + count
+    state[_P3H], state[_PPH], state[_PH] = hh[count], hh[count + 1], hh[count + 2]
+    state[_P3L], state[_PPL], state[_PL] = ll[count], ll[count + 1], ll[count + 2]
+    state[_PD1] = d1[size]
+    state[_PD2] = d2[size - 1]
 
 
 @njit(cache=True, nogil=True)
 def _stretch(y, centre, slope, scale, order, first_block, stop_block, levels, states, top_hi, top_lo, tails,
              block_exp):
     """The lower ``levels`` levels (at most ``block_exp``) of the blocks ``first_block ..
-    stop_block - 1`` (the last may be partial), block by block: each block's pyramid in a
-    buffer of half a block, the per-level state carried from block to block; every full
-    block's level-``block_exp`` cluster sum goes to ``top_hi/lo[block]``."""
+    stop_block - 1`` (the last may be partial), block by block: each block's pyramid in two
+    buffers of a block (each level's clusters after the three before them), the per-level
+    state carried from block to block; every full block's level-``block_exp`` cluster sum
+    goes to ``top_hi/lo[block]``."""
     n = y.shape[0]
     block = 1 << block_exp
-    buffer_hi = np.empty(block // 2)
-    buffer_lo = np.empty(block // 2)
+    a_hi = np.empty(block + 3)
+    a_lo = np.empty(block + 3)
+    b_hi = np.empty(block + 3)
+    b_lo = np.empty(block + 3)
+    v = np.empty(PIECE + 1)
+    d1 = np.empty(PIECE + 1)
+    d2 = np.empty(PIECE + 1)
+    d3 = np.empty(PIECE + 1)
+    z = np.empty(PIECE + 1)
     no_tail = np.empty(0)
     for b in range(first_block, stop_block):
         count = min(block, n - b * block)
         j0 = (b - first_block) * block
+        _increments(y, b * block, count, centre, slope, scale, a_hi, a_lo)
+        src_hi, src_lo, dst_hi, dst_lo = a_hi, a_lo, b_hi, b_lo
         for level in range(levels):
             tail = tails[level] if (n >> level) <= tails.shape[1] else no_tail
             k0 = first_block << (block_exp - level)
-            if level == 0:
-                _first_chunk(y, b * block, centre, slope, scale, order, count, j0, states[0], buffer_hi, buffer_lo,
-                             tail, k0)
+            if j0 >= 3 and count >= FAST_MIN and tail.shape[0] == 0:
+                _chunk_fast(src_hi, src_lo, order, count, states[level], dst_hi, dst_lo, v, d1, d2, d3, z)
             else:
-                _upper_chunk(buffer_hi, buffer_lo, order, count, j0, states[level], buffer_hi, buffer_lo, tail, k0)
+                _chunk_body(src_hi[3:], src_lo[3:], order, count, j0, states[level], dst_hi[3:], dst_lo[3:], tail,
+                            k0)
+            src_hi, src_lo, dst_hi, dst_lo = dst_hi, dst_lo, src_hi, src_lo
             count //= 2
             j0 //= 2
         if levels == block_exp and count == 1:
-            top_hi[b] = buffer_hi[0]
-            top_lo[b] = buffer_lo[0]
+            top_hi[b] = src_hi[3]
+            top_lo[b] = src_lo[3]
 
 
 @njit(cache=True, nogil=True)
@@ -280,6 +387,6 @@ def octave_moments(y, centre, slope, scale, order, n_levels, stats, tails):
     for level in range(low, n_levels):  # the upper levels: on the full blocks' sums, in place
         _start(state, count, 0, 0.0)
         tail = tails[level] if count <= tails.shape[1] else no_tail
-        _upper_chunk(top_hi, top_lo, order, count, 0, state, top_hi, top_lo, tail, 0)
+        _chunk_body(top_hi, top_lo, order, count, 0, state, top_hi, top_lo, tail, 0)
         _moments_row(state, count, stats[level])
         count //= 2

@@ -46,14 +46,17 @@ def _filled(data: np.ndarray, is_phase: bool, n_missing: int) -> tuple[np.ndarra
     return filled, bad
 
 
-def _drift(data: np.ndarray, is_phase: bool) -> float:
+def _drift(data: np.ndarray, is_phase: bool, moment: float = np.nan) -> float:
     """Least-squares slope of the increments (the frequency, or the phase's differences)
     against their index, rounded so that ``slope * i`` is exact for every index (the
-    Hadamard family removes it)."""
+    Hadamard family removes it). ``moment``: their centred moment if already known (NaN
+    if not: :func:`scan` finds it for gap-free frequency data)."""
     count = data.shape[0] - int(is_phase)
     if count < 3:
         return 0.0
-    slope = centred_moment(data, int(is_phase)) / (count * (count * count - 1.0) / 12.0)
+    if np.isnan(moment):
+        moment = centred_moment(data, int(is_phase))
+    slope = moment / (count * (count * count - 1.0) / 12.0)
     if slope == 0.0 or not np.isfinite(slope):
         return 0.0
     _, exponent = np.frexp(slope)
@@ -88,9 +91,9 @@ class OctaveMoments(NamedTuple):
 def _octave_sums(estimator: str, data: np.ndarray, factors: np.ndarray, scanned: tuple):
     """ADEV/HDEV of gap-free frequency data at m = 1, 2, 4, ... by the Haar pyramid
     (:mod:`avar._kernels.pyramid`): ``sums, counts, scale, moments, drift``."""
-    _, total, low, high = scanned
+    _, total, low, high, moment = scanned
     count = data.shape[0]
-    slope = _drift(data, False) if estimator == "hdev" else 0.0
+    slope = _drift(data, False, moment) if estimator == "hdev" else 0.0
     centre = total / count - slope * (count - 1) / 2
     scale = _scale(low, high, centre)
     stats = np.zeros((factors.size, len(MOMENTS)))
@@ -135,12 +138,12 @@ def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple
     already known.
     """
     is_phase = data_type == "phase"
-    n_missing, total, low, high = scan(data) if scanned is None else scanned
+    n_missing, total, low, high, moment = scan(data) if scanned is None else scanned
     filled, bad = _filled(data, is_phase, n_missing)
     count = filled.shape[0] - 1 if is_phase else filled.shape[0]
     slope = 0.0
     if estimator in ("hdev", "ohdev"):
-        slope = _drift(filled, is_phase)
+        slope = _drift(filled, is_phase, np.nan if is_phase else moment)
     if is_phase:
         centre = (filled[-1] - filled[0]) / count - slope * (count - 1) / 2
         origin = filled[0]

@@ -72,8 +72,9 @@ _PARAMETERS = """
 """
 
 
-def _check_data(data: Any, data_type: str, nan_policy: str) -> tuple[np.ndarray, tuple]:
-    """Float64 values of ``data`` and their :func:`scan` (NaN count, sum, min, max), or an error naming ``data``."""
+def _check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False) -> tuple[np.ndarray, tuple]:
+    """Float64 values of ``data`` and their :func:`scan` (NaN count, sum, min, max, and with
+    ``weigh`` the centred moment), or an error naming ``data``."""
     if isinstance(data, pd.DataFrame):
         raise TypeError("data is a DataFrame; give one column (a 1-D series) of phase or frequency data")
     if isinstance(data, pd.Series):
@@ -87,7 +88,7 @@ def _check_data(data: Any, data_type: str, nan_policy: str) -> tuple[np.ndarray,
     values = np.ascontiguousarray(as_float64(array), dtype=np.float64)
     if not values.flags.writeable:  # one compiled signature of the kernels
         values = values.copy()
-    scanned = scan(values) if values.size else (0, 0.0, np.inf, -np.inf)  # one pass: NaN, sum, min, max
+    scanned = scan(values, weigh=weigh) if values.size else (0, 0.0, np.inf, -np.inf, np.nan)  # one pass
     if np.isinf(scanned[2]) and scanned[0] < values.size or np.isinf(scanned[3]) and scanned[0] < values.size:
         infinite = np.flatnonzero(np.isinf(values))
         raise ValueError(f"data has {infinite.size} infinite value(s), the first at index {infinite[0]}; "
@@ -156,7 +157,8 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
               nan_policy: Any) -> Deviation:
     """Validate once, compute the variances, identify the noise and bound the deviation."""
     rate = _check_options(estimator, rate, data_type, confidence, nan_policy)
-    values, scanned = _check_data(data, data_type, nan_policy)
+    drift_removed = estimator in ("hdev", "ohdev") and data_type == "freq"  # the scan finds the drift too
+    values, scanned = _check_data(data, data_type, nan_policy, weigh=drift_removed)
     n_missing = int(scanned[0])
     n_phase = values.size + (data_type == "freq")
     needed = MIN_PHASE_POINTS[estimator] - (data_type == "freq")
