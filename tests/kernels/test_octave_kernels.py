@@ -246,3 +246,22 @@ def test_second_differences_scale_extreme_samples_before_rounding():
     want = [(x[i + 2, 0] * 2.0**-1000 - 2 * x[i + 1, 0] * 2.0**-1000 + x[i, 0] * 2.0**-1000) for i in range(2)]
     np.testing.assert_allclose(steps[:2], want, rtol=1e-15)
     assert np.isfinite(steps).all()
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32, np.int16])
+def test_block_magnitude_is_the_largest_magnitude_or_nan(dtype):
+    """The Haar pyramid's magnitude probe: max |x sc| (bit patterns for float64), NaN if a
+    sample is inf or NaN, at any position (vector body and tail)."""
+    from avar._kernels.haar import block_magnitude
+
+    rng = np.random.default_rng(1)
+    x = (rng.standard_normal(37) * 1e3).astype(dtype)
+    x[5] = -3e4 if np.dtype(dtype).kind == "f" else -30000
+    assert block_magnitude(x, 0.5) == 15000.0
+    assert block_magnitude(np.zeros(3, dtype=dtype), 1.0) == 0.0
+    if np.dtype(dtype).kind == "f":
+        for bad in (np.inf, -np.inf, np.nan):
+            for position in (0, 20, 36):
+                y = x.copy()
+                y[position] = bad
+                assert np.isnan(block_magnitude(y, 1.0)), (bad, position)

@@ -12,7 +12,12 @@ Exactness: every cluster sum is a double-double ``hi + lo`` (TwoSum of the
 pairs; 64-bit integers enter as two exact halves), so sums are exact to
 O(eps**2) of the cluster magnitude without centring (the differences of
 consecutive clusters do not depend on the centre); the difference of two
-clusters is formed with TwoSum as well. Work is split into tasks of
+clusters is formed with TwoSum as well. Samples exact in one float64 (all
+but 64-bit integers) skip the pairs at level 0: the difference of two
+samples, rounded once, is as exact as the pairs' (:func:`_first_level`), and the
+block's magnitude is the maximum of the samples' bit patterns. Blocks are
+read from the transposed input, so a single column's block is contiguous
+(vectorized loads). Work is split into tasks of
 ``CHUNK_BLOCKS`` blocks whose partial sums, and the differences across task
 boundaries, are added in a fixed order: the bits do not depend on the number
 of threads.
@@ -68,25 +73,109 @@ def _dd_diff(ah, al, bh, bl):
     return s + (e + (al - bl))
 
 
+#: Bits of a float64's magnitude; a magnitude's bits at or above INFINITY_BITS are inf or NaN.
+MAGNITUDE_MASK = np.int64(0x7FFFFFFFFFFFFFFF)
+INFINITY_BITS = np.int64(0x7FF0000000000000)
+
+
 @njit(cache=True)
-def _block(data, col, start, count, sc, h, l, buffer, levels, first_h, first_l, last_h, last_l, have, sums):
+def _magnitude(x):
+    """Largest ``|x|`` of float64 values, NaN if one is not finite: the maximum of the
+    magnitudes' bit patterns (ordered as the magnitudes; integer maxima vectorize)."""
+    bits = x.view(np.int64)
+    top = np.int64(0)
+    for i in range(bits.shape[0]):
+        top = max(top, bits[i] & MAGNITUDE_MASK)
+    if top >= INFINITY_BITS:
+        return np.nan
+    return np.array([top]).view(np.float64)[0]
+
+
+def _scaled_magnitude(x, sc):  # pragma: no cover - replaced by the overload in compiled code
+    raise NotImplementedError
+
+
+@overload(_scaled_magnitude)
+def _scaled_magnitude_overload(x, sc):
+    """Largest ``|x sc|`` (``sc`` a power of two), NaN if a sample is not finite."""
+    if x.dtype == types.float64:
+        return lambda x, sc: _magnitude(x) * sc
+
+    def impl(x, sc):  # narrower types: exact in float64
+        top = 0.0
+        probe = 0.0
+        for i in range(x.shape[0]):
+            a = abs(np.float64(x[i]))
+            top = a if a > top else top
+            probe += 0.0 * a
+        return top * sc + probe
+
+    return impl
+
+
+def _is_wide(x):  # pragma: no cover - replaced by the overload in compiled code
+    raise NotImplementedError
+
+
+@overload(_is_wide, inline="always")
+def _is_wide_overload(x):
+    """Whether samples of this type are not exact in one float64 (64-bit integers)."""
+    wide = isinstance(x, types.Integer) and x.bitwidth == 64
+    return lambda x: wide
+
+
+@njit(cache=True)
+def block_magnitude(x, sc):
+    """Largest ``|x sc|`` of a block of samples (not 64-bit integers), NaN if one is not finite."""
+    return _scaled_magnitude(x, sc)
+
+
+@njit(cache=True)
+def _first_level(x, sc, h, l, buffer):
+    """Level 0 of a block of float64-exact samples ``x``: returns the sum of the squared
+    differences of consecutive samples (each one rounding: exact up to it) and leaves the
+    exact pair sums (level 1) in ``h, l[: count // 2]``."""
+    count = x.shape[0]
+    for j in range(count - 1):
+        d = (np.float64(x[j + 1]) - np.float64(x[j])) * sc
+        buffer[j] = d * d
+    for j in range(count // 2):
+        h[j], l[j] = _two_sum(np.float64(x[2 * j]) * sc, np.float64(x[2 * j + 1]) * sc)
+    return _fast_sum(buffer, count - 1)
+
+
+@njit(cache=True)
+def _block(rows, col, start, count, sc, h, l, buffer, levels, first_h, first_l, last_h, last_l, have, sums):
     """Pyramid of one block of ``count`` samples; updates the carried state of levels 0..P.
 
-    Returns the largest magnitude of the block (to detect extreme scales; nan
-    if a sample is not finite).
+    ``rows``: the input transposed (C, N), so that a single-column input's block is a
+    contiguous row (vectorized loads). Returns the largest magnitude of the block (to
+    detect extreme scales; nan if a sample is not finite).
     """
-    x = data[start : start + count, col]
-    big = 0.0
-    probe = 0.0  # nan if a sample is not finite
-    # level 0: the samples themselves (differences of consecutive samples)
-    for i in range(count):
-        a, b = _pair(x[i], sc)
-        h[i] = a
-        l[i] = b
-        big = max(big, abs(a))
-        probe += 0.0 * a
+    x = rows[col, start : start + count]
     width = count
-    for k in range(levels):
+    k0 = 0
+    if _is_wide(x[0]):  # 64-bit integers: level 0 from exact pairs like the others
+        for i in range(count):
+            h[i], l[i] = _pair(x[i], sc)
+        magnitude = _magnitude(h[:count])
+    else:
+        magnitude = block_magnitude(x, sc)
+        if levels > 0:
+            total = _first_level(x, sc, h, l, buffer)
+            if have[0]:
+                d = np.float64(x[0]) * sc - last_h[0]
+                total += d * d
+            else:
+                first_h[0] = np.float64(x[0]) * sc
+                first_l[0] = 0.0
+                have[0] = True
+            sums[0] += total
+            last_h[0] = np.float64(x[count - 1]) * sc
+            last_l[0] = 0.0
+            width = count // 2
+            k0 = 1
+    for k in range(k0, levels):
         if width == 0:
             break
         for j in range(width - 1):
@@ -107,12 +196,12 @@ def _block(data, col, start, count, sc, h, l, buffer, levels, first_h, first_l, 
         for j in range(half):
             h[j], l[j] = _dd_add(h[2 * j], l[2 * j], h[2 * j + 1], l[2 * j + 1])
         width = half
-    return big + probe
+    return magnitude
 
 
 @njit(cache=True)
-def _task(data, col, kb0, kb1, sc, levels, block, sums, first_h, first_l, last_h, last_l, have, bh, bl):
-    n = data.shape[0]
+def _task(rows, col, kb0, kb1, sc, levels, block, sums, first_h, first_l, last_h, last_l, have, bh, bl):
+    n = rows.shape[1]
     h = np.empty(block)
     l = np.empty(block)
     buffer = np.empty(block)
@@ -121,7 +210,7 @@ def _task(data, col, kb0, kb1, sc, levels, block, sums, first_h, first_l, last_h
     for kb in range(kb0, kb1):
         start = kb * block
         count = min(block, n - start)
-        r = _block(data, col, start, count, sc, h, l, buffer, levels, first_h, first_l, last_h, last_l, have, sums)
+        r = _block(rows, col, start, count, sc, h, l, buffer, levels, first_h, first_l, last_h, last_l, have, sums)
         finite = finite and np.isfinite(r)
         big = max(big, r)
         if count == block:  # a whole block: its sum feeds the upper levels
@@ -131,12 +220,12 @@ def _task(data, col, kb0, kb1, sc, levels, block, sums, first_h, first_l, last_h
 
 
 @njit(cache=True, parallel=True)
-def _tasks_parallel(data, sc, levels, block, chunk, n_tasks, n_blocks, sums, fh, fl, lh, ll, have, bh, bl, big):
-    channels = data.shape[1]
+def _tasks_parallel(rows, sc, levels, block, chunk, n_tasks, n_blocks, sums, fh, fl, lh, ll, have, bh, bl, big):
+    channels = rows.shape[0]
     for task in prange(channels * n_tasks):
         c = task // n_tasks
         j = task % n_tasks
-        big[c, j] = _task(data, c, j * chunk, min(n_blocks, (j + 1) * chunk), sc[c], levels, block,
+        big[c, j] = _task(rows, c, j * chunk, min(n_blocks, (j + 1) * chunk), sc[c], levels, block,
                           sums[c, j], fh[c, j], fl[c, j], lh[c, j], ll[c, j], have[c, j], bh[c], bl[c])
 
 
@@ -189,6 +278,6 @@ def haar_sums(data, scale, n_levels, exp=PYRAMID_EXP, chunk=CHUNK_BLOCKS):
     have = np.zeros(shape, dtype=np.bool_)
     bh, bl = np.zeros((channels, n_blocks)), np.zeros((channels, n_blocks))
     big = np.zeros((channels, n_tasks))
-    _tasks_parallel(data, scale, levels, block, chunk, n_tasks, n_blocks, sums, fh, fl, lh, ll, have, bh, bl, big)
+    _tasks_parallel(data.T, scale, levels, block, chunk, n_tasks, n_blocks, sums, fh, fl, lh, ll, have, bh, bl, big)
     out = _combine(sums, fh, fl, lh, ll, have, bh, bl, n // block, levels, n_levels)
     return out, big.max(axis=1)
