@@ -307,13 +307,14 @@ def rate_from_index(index: Any, what: str) -> float | None:
 
 
 def native_values(array: np.ndarray) -> np.ndarray | None:
-    """``array`` itself when valid as it is, else None: integers, booleans, float32/64 (magnitudes near the
-    float64 limit are the kernels' to rescale). Up to 2**20 floats, the sum must be finite (so every value
-    is); beyond, the kernels' own pass finds a non-finite value (:func:`check_finite` then reports it)."""
-    if array.dtype.kind in "biu" or (array.dtype.kind == "f" and array.itemsize >= 4 and array.size > 2**20):
+    """``array`` itself when the kernels read it as it is, else None: integers, booleans, float32/64
+    (magnitudes near the float64 limit are the kernels' to rescale). A non-finite value is not looked
+    for here: it makes the kernels' centre, hence every level, non-finite, and
+    :func:`avar.stability.columns.allan_variance_columns` then reports it (:func:`check_finite`),
+    so valid data is read once less."""
+    if array.dtype.kind in "biu" or (array.dtype.kind == "f" and array.itemsize >= 4):
         return array
-    with np.errstate(over="ignore", invalid="ignore"):
-        return array if array.dtype.kind == "f" and array.itemsize >= 4 and np.isfinite(array.sum()) else None
+    return None
 
 
 def as_series(x: Any, freq: Any, native: bool = False) -> tuple[np.ndarray, float]:

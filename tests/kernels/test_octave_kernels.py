@@ -153,16 +153,20 @@ def test_small_path_matches_loop_on_every_scale(type):
     np.testing.assert_allclose(got, exact(x, factors, type), rtol=1e-10)
 
 
+@pytest.mark.parametrize("n", [5, 300, 40_000, 300_000])  # small path, on threads, sweep / pyramid / levels
 @pytest.mark.parametrize("type", ["mo", "to"])
-def test_long_series_non_finite_values_are_found_by_the_kernel_pass(type):
+def test_non_finite_values_are_found_by_the_kernel_pass(type, n):
+    """No up-front scan: a NaN or infinity anywhere (also in a tail no "to" cluster covers)
+    makes the kernels' centre non-finite, and the error names its index, on every path."""
     import avar
 
-    n = 2**20 + 5  # beyond the up-front check: the kernels' pass finds the value
-    for position in (0, n - 1):
-        x = np.zeros(n, dtype=np.float32)
-        x[position] = np.inf
-        with pytest.raises(ValueError, match=rf"1 non-finite value\(s\) \(0 NaN, 1 inf\); the first is at index {position}"):
-            avar.avar(x, type=type)
+    for taus in ("octave", [2.0] if n < 10 else [3.0, 6.0, 7.0]):
+        for position in (0, n // 2, n - 1):
+            for value, label in ((np.inf, r"0 NaN, 1 inf"), (np.nan, r"1 NaN, 0 inf")):
+                x = np.zeros(n, dtype=np.float32 if position else np.float64)
+                x[position] = value
+                with pytest.raises(ValueError, match=rf"1 non-finite value\(s\) \({label}\); the first is at index {position}"):
+                    avar.avar(x, type=type, taus=taus)
 
 
 def test_certified_plain_sums_are_taken_only_when_provably_accurate():
