@@ -58,7 +58,8 @@ def _scan_block_fast(data, start, stop, weigh):
     for i in range(n4, values.shape[0]):
         v = values[i]
         total += v
-        weighted += np.float64(i) * v
+        if weigh:
+            weighted += np.float64(i) * v
         count += v != v
         l0 = v if v < l0 else l0
         h0 = v if v > h0 else h0
