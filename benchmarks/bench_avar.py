@@ -174,7 +174,7 @@ def main() -> None:
         for type in ("mo", "to"):
             if (exponent, type) in times and times[exponent, type][1] is not None:
                 ours, at, _ = times[exponent, type]
-                print(f"  N=1e{exponent} {type}: {at / ours:.1f}x allantools (need >= {need:g}x): "
+                print(f"  N=1e{exponent} {type}: {at / ours:.2f}x allantools (need >= {need:g}x): "
                       f"{'met' if at / ours >= need else 'NOT met'}")
     if (3, "mo") in times:
         small = max(times[3, "mo"][0], times[3, "to"][0])

@@ -123,7 +123,7 @@ def main() -> None:
     if public_ratio:
         print(f"\nAcceptance (public function >= {TARGET:g}x the plain allantools call at N = {ACCEPTANCE_N:.0e}):")
         for estimator, ratio in public_ratio.items():
-            print(f"  {estimator:7s} {ratio:5.1f}x  {'holds' if ratio >= TARGET else 'NOT MET'}")
+            print(f"  {estimator:7s} {ratio:5.2f}x  {'holds' if ratio >= TARGET else 'NOT MET'}")
 
 
 if __name__ == "__main__":
