@@ -35,7 +35,7 @@ from numba.extending import overload
 from avar._kernels.haar import _pair
 from avar._kernels.streaming import _two_sum, window_level_sums
 
-#: Samples per block (region alignment, table granularity).
+#: Samples per block: the table's granularity, the steps of a large level per block, the window's advance.
 SWEEP_BLOCK = 1 << 13
 
 #: Levels below this cluster size are served by the sliding window (a power of
