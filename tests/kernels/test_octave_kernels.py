@@ -65,7 +65,7 @@ def run(x, factors, type, **tiny):
     return columns.run_haar(data, factors, nd, **tiny)
 
 
-TINY = {"mo": dict(block=64, near=256, chunk=3), "to": dict(exp=5, chunk=3)}
+TINY = {"mo": dict(block=64, near=256, chunk=3, fine=16), "to": dict(exp=5, chunk=3)}
 
 
 @pytest.mark.parametrize("name", ["offset", "drift", "random walk", "step"])
@@ -216,7 +216,7 @@ def test_sweep_steps_and_chained_squares_match_exact_arithmetic(dtype, count):
     """The sweep's large levels: steps ``x[t+2m] - 2 x[t+m] + x[t]`` rounded once, and the sum of
     the squares of the running ``D`` they drive (started from an exact ``D_0``), against
     Fractions, on an offset far above the noise (where a prefix-sum method would cancel)."""
-    from avar._kernels.sweep import chained_squares, second_differences
+    from avar._kernels.far import chained_squares, second_differences
 
     rng = np.random.default_rng(count)
     n, m, t0 = 3 * 4096, 1024, 37
@@ -241,8 +241,60 @@ def test_sweep_steps_and_chained_squares_match_exact_arithmetic(dtype, count):
     assert got == pytest.approx(float(want), rel=1e-12)
 
 
+@pytest.mark.parametrize("name", ["white", "offset", "drift", "random walk", "step"])
+def test_far_levels_exact_with_plain_steps_exact_steps_or_either(name):
+    """The large levels (residue classes, pieces of ``fine`` samples): exact against Fractions
+    whether every piece keeps its plain steps (tol = inf), takes the once-rounded steps
+    (tol = 0) or is certified piece by piece (the default)."""
+    n = 3000
+    x = np.random.default_rng(4).standard_normal(n) if name == "white" else adversarial(n)[name]
+    factors = np.array([1, 2, 256, 512, 1024], dtype=np.int64)  # near=256: three large levels
+    want = exact(x, factors, "mo")
+    for tol in (np.inf, 0.0, None):
+        extra = {} if tol is None else {"tol": tol}
+        got = run(x, factors, "mo", **TINY["mo"], **extra)[0]
+        np.testing.assert_allclose(got, want, rtol=1e-10, atol=0, err_msg=f"tol={tol}")
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32, np.int16])
+@pytest.mark.parametrize("name", ["white", "offset", "drift", "random walk", "step", "periodic"])
+def test_plain_steps_err_within_their_certified_bound(name, dtype):
+    """Every running sum of the plain steps' errors (against Fractions) is within
+    :func:`step_error_bound` of the samples' distance from the centre. Noise is certified
+    by it, also on a large offset (the distance is from the centre); a period dividing
+    ``m`` far above the noise is not (``D`` is then only the noise), so such pieces take
+    the once-rounded steps."""
+    from avar._kernels.far import chained_squares, plain_second_differences, step_error_bound
+    from avar._kernels.streaming import CERTIFY_TOL, certified
+
+    n, m, t0, count = 3000, 512, 123, 900
+    rng = np.random.default_rng(6)
+    if name == "white":
+        base = rng.standard_normal(n)
+    elif name == "periodic":
+        base = 1e3 * np.sin(2 * np.pi * np.arange(n) / 64) + 1e-6 * rng.standard_normal(n)
+    else:
+        base = adversarial(n)[name]
+    x = np.round(base * 100).astype(dtype) if dtype == np.int16 else base.astype(dtype)
+    centre = float(np.mean(x.astype(np.float64)))
+    steps = np.empty(count)
+    plain_second_differences(x[None, :], 0, t0, m, count, 1.0, steps)
+    v = [Fraction(float(a)) for a in x]
+    error, worst = Fraction(0), 0.0
+    for i in range(count - 1):
+        error += Fraction(float(steps[i])) - (v[t0 + i + 2 * m] - 2 * v[t0 + i + m] + v[t0 + i])
+        worst = max(worst, abs(float(error)))
+    r = [float(np.max(np.abs(x[t0 + j * m : t0 + j * m + count].astype(np.float64) - centre))) for j in range(3)]
+    bound = step_error_bound(r[0], r[1], r[2], count)
+    assert worst <= bound
+    if dtype == np.float64 and name in ("white", "offset", "periodic"):
+        d0 = float(sum(v[t0 + 2 * m - j] - v[t0 + m - j] for j in range(1, m + 1)))
+        total = chained_squares(d0, steps, count)
+        assert certified(total, bound, count, CERTIFY_TOL) == (name != "periodic")
+
+
 def test_second_differences_scale_extreme_samples_before_rounding():
-    from avar._kernels.sweep import second_differences
+    from avar._kernels.far import second_differences
 
     x = np.array([1e300, -1e300, 1e300, 3e300, -1e300, 2e300])[:, None]
     steps = np.empty(3)

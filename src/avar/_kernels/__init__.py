@@ -11,8 +11,9 @@ tests check every kernel against a plain NumPy transcription.
   blocks, a small workspace instead of O(N) arrays). It dispatches to
   :mod:`avar._kernels.small` (short series: one call, one thread),
   :mod:`avar._kernels.haar` (octave "to": the Haar pyramid, one read),
-  :mod:`avar._kernels.sweep` (octave "mo": a cache-blocked sweep of all
-  levels) or :mod:`avar._kernels.levels` (any other grid, level by level),
+  :mod:`avar._kernels.sweep` and :mod:`avar._kernels.far` (octave "mo":
+  a cache-blocked sweep of the small levels, the large ones by residue
+  class) or :mod:`avar._kernels.levels` (any other grid, level by level),
   all on the primitives of :mod:`avar._kernels.streaming`.
 * :mod:`avar._kernels.covariance`: the theoretical Allan variance of a
   covariance matrix (one validating pass, then O(n) per scale).

@@ -8,11 +8,12 @@ import numba
 import numpy as np
 from numba import njit
 
+from avar._kernels.far import SWEEP_FINE, far_sums
 from avar._kernels.haar import CHUNK_BLOCKS as HAAR_CHUNK
 from avar._kernels.haar import PYRAMID_EXP, haar_sums
 from avar._kernels.levels import level_sums
 from avar._kernels.small import small_allan_variance, small_allan_variance_parallel
-from avar._kernels.streaming import BLOCK, CHUNK_BLOCKS, LIMIT_EXP, NEAR, block_table
+from avar._kernels.streaming import BLOCK, CERTIFY_TOL, CHUNK_BLOCKS, LIMIT_EXP, NEAR, block_table
 from avar._kernels.sweep import SWEEP_BLOCK, SWEEP_CHUNK, SWEEP_NEAR, sweep_sums
 
 #: Series of at most this many samples take the one-call small path
@@ -54,18 +55,18 @@ def _finish(sums, scale, factors, n_diff):
 
 
 def _table(data, block):
-    """Block table with the scale of extreme columns: (th, tl, centre, scale)."""
+    """Block table with the scale of extreme columns: (th, tl, centre, scale, spread)."""
     integral = data.dtype.kind in "iu"
-    th, tl, centre, maxabs = block_table(data, np.ones(data.shape[1]), integral, block)
+    th, tl, centre, maxabs, spread = block_table(data, np.ones(data.shape[1]), integral, block)
     scale, redo = _scales(maxabs)
     if redo:
-        th, tl, centre, maxabs = block_table(data, scale, integral, block)
-    return th, tl, centre, scale
+        th, tl, centre, maxabs, spread = block_table(data, scale, integral, block)
+    return th, tl, centre, scale, spread
 
 
 def run_levels(data, factors, n_diff, is_mo, block=BLOCK, near=NEAR, chunk=CHUNK_BLOCKS):
     """Any grid (``factors`` increasing, all valid): level by level (:mod:`avar._kernels.levels`)."""
-    th, tl, centre, scale = _table(data, block)
+    th, tl, centre, scale, _ = _table(data, block)
     counts = n_diff if is_mo else data.shape[0] // factors
     small_count = int(np.searchsorted(factors, near, side="right")) if is_mo else factors.shape[0]
     sums = level_sums(data, centre, scale, th, tl, factors, counts, is_mo, small_count, block, near, chunk)
@@ -95,12 +96,20 @@ def run_haar(data, factors, n_diff, exp=PYRAMID_EXP, chunk=None):
     return out
 
 
-def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=None):
-    """"mo" at power-of-two cluster sizes ``factors`` (increasing): the cache-blocked sweep."""
-    chunk = _chunk(n_diff[0], block, SWEEP_CHUNK) if chunk is None else chunk
-    th, tl, centre, scale = _table(data, block)
-    n_small = int(np.searchsorted(factors, max(near, block)))
-    sums = sweep_sums(data, data.T, centre, scale, th, tl, factors, n_diff, n_small, block, chunk)
+def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=None, fine=SWEEP_FINE,
+              tol=CERTIFY_TOL):
+    """"mo" at power-of-two cluster sizes ``factors`` (increasing): the levels below ``near``
+    by the cache-blocked sweep (:mod:`avar._kernels.sweep`), the others by residue class
+    (:mod:`avar._kernels.far`, table granularity ``fine``, certification tolerance ``tol``)."""
+    n_small = int(np.searchsorted(factors, near))
+    fine = min(fine, int(factors[n_small])) if n_small < factors.shape[0] else fine
+    th, tl, centre, scale, spread = _table(data, fine)
+    sums = np.empty((data.shape[1], factors.shape[0]))
+    if n_small > 0:
+        chunk = _chunk(n_diff[0], block, SWEEP_CHUNK) if chunk is None else chunk
+        sums[:, :n_small] = sweep_sums(data, centre, scale, factors[:n_small], n_diff[:n_small], block, chunk)
+    if n_small < factors.shape[0]:
+        sums[:, n_small:] = far_sums(data.T, scale, th, tl, spread, factors[n_small:], n_diff[n_small:], fine, tol)
     return _finish(sums, scale, factors, n_diff.astype(np.float64))
 
 

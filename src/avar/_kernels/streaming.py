@@ -103,17 +103,20 @@ def _centred_overload(x, c, sc):
 
 @njit(cache=True)
 def _block_sum(data, col, start, stop, scale):
-    """Compensated sum of ``data[start:stop, col] * scale`` and the largest magnitude."""
+    """Compensated sum of ``data[start:stop, col] * scale`` and its least and largest value
+    (of the high parts, for 64-bit integers)."""
     total = 0.0
     comp = 0.0
-    big = 0.0
+    low = np.inf
+    high = -np.inf
     x = data[start:stop, col]
     for i in range(stop - start):
         yh, yl = _centred(x[i], 0.0, scale)
-        big = max(big, abs(yh))
+        low = min(low, yh)
+        high = max(high, yh)
         total, e = _two_sum(total, yh)
         comp += e + yl
-    return total, comp, big
+    return total, comp, low, high
 
 
 @njit(cache=True)
@@ -158,36 +161,50 @@ def _table_column(bh, bl, n, block, integral, out_hi, out_lo):
     return centre
 
 
+#: Samples summed per parallel task of :func:`block_table` (whole blocks).
+TABLE_TASK = 1 << 16
+
+
 @njit(cache=True, parallel=True)
 def block_table(data, scale, integral, block=BLOCK):
-    """Pass 1 over all columns: returns (table_hi, table_lo, centre, maxabs).
+    """Pass 1 over all columns: returns (table_hi, table_lo, centre, maxabs, spread).
 
     ``table_*`` have shape (C, ceil(N / block) + 1) with the centred
-    cumulative sum of ``data * scale`` at every block boundary (and at N).
+    cumulative sum of ``data * scale`` at every block boundary (and at N);
+    ``spread`` (C, ceil(N / block)) bounds ``|x * scale - centre|`` over each
+    block (rounded up: it bounds the rounding of plain differences of samples).
     """
     n, channels = data.shape
     nb = (n + block - 1) // block
+    per_task = max(1, TABLE_TASK // block)
+    n_tasks = (nb + per_task - 1) // per_task
     bh = np.empty((channels, nb))
     bl = np.empty((channels, nb))
-    bm = np.empty((channels, nb))
-    for task in prange(channels * nb):
-        c = task // nb
-        b = task % nb
-        bh[c, b], bl[c, b], bm[c, b] = _block_sum(data, c, b * block, min(n, (b + 1) * block), scale[c])
-    return _finish_table(bh, bl, bm, n, block, integral)
+    low = np.empty((channels, nb))
+    high = np.empty((channels, nb))
+    for task in prange(channels * n_tasks):
+        c = task // n_tasks
+        j = task % n_tasks
+        for b in range(j * per_task, min(nb, (j + 1) * per_task)):
+            bh[c, b], bl[c, b], low[c, b], high[c, b] = _block_sum(data, c, b * block, min(n, (b + 1) * block),
+                                                                   scale[c])
+    return _finish_table(bh, bl, low, high, n, block, integral)
 
 
 @njit(cache=True)
-def _finish_table(bh, bl, bm, n, block, integral):
+def _finish_table(bh, bl, low, high, n, block, integral):
     channels, nb = bh.shape
     table_hi = np.empty((channels, nb + 1))
     table_lo = np.empty((channels, nb + 1))
     centre = np.empty(channels)
-    maxabs = np.empty(channels)
+    maxabs = np.zeros(channels)
+    spread = np.empty((channels, nb))
     for c in range(channels):
         centre[c] = _table_column(bh[c], bl[c], n, block, integral, table_hi[c], table_lo[c])
-        maxabs[c] = bm[c].max() if nb > 0 else 0.0
-    return table_hi, table_lo, centre, maxabs
+        for b in range(nb):
+            maxabs[c] = max(maxabs[c], max(-low[c, b], high[c, b]))
+            spread[c, b] = max(high[c, b] - centre[c], centre[c] - low[c, b]) * (1.0 + 2.0**-40)
+    return table_hi, table_lo, centre, maxabs, spread
 
 
 @njit(cache=True)
@@ -292,6 +309,16 @@ def plain_squares(h, a, m, count):
 
 
 @njit(cache=True)
+def certified(total, delta, count, tol):
+    """Whether ``count`` squares summing to ``total`` are within ``tol`` (relative) of
+    their exact sum when every squared value errs by at most ``delta``: the bound
+    ``2 delta sqrt(count total) + count delta**2`` (Cauchy-Schwarz). False for a zero,
+    infinite or NaN ``total`` (the caller then takes its exact path)."""
+    bound = 2.0 * delta * np.sqrt(count * total) + count * delta * delta
+    return total > 0.0 and np.isfinite(total) and bound <= tol * total
+
+
+@njit(cache=True)
 def certified_squares(h, l, a, m, count, buffer, bounds):
     """:func:`squares` of one window (``S = h + l`` at offsets a, a + m, a + 2m) by the plain
     :func:`plain_squares` of ``h`` alone when its error is provably below :data:`CERTIFY_TOL`.
@@ -307,8 +334,7 @@ def certified_squares(h, l, a, m, count, buffer, bounds):
     compensated path's workspace (allocated here if shorter than ``count``).
     """
     total = plain_squares(h, a, m, count)
-    delta = 4.0 * bounds[1] + 9.0 * _EPS * bounds[0]
-    if total > 0.0 and 2.0 * delta * np.sqrt(count * total) + count * delta * delta <= CERTIFY_TOL * total:
+    if certified(total, 4.0 * bounds[1] + 9.0 * _EPS * bounds[0], count, CERTIFY_TOL):
         return total
     if buffer.shape[0] < count:  # a workspace only when needed
         buffer = np.empty(count)
