@@ -40,6 +40,7 @@ import numpy as np
 from timing import median_time  # benchmarks/timing.py
 
 import avar
+from avar._kernels.streaming import plain_squares  # the library's plain float64 level sum
 from avar.stability.grids import averaging_factors
 
 try:
@@ -60,18 +61,6 @@ def numpy_cumsum_avar(x: np.ndarray, factors: np.ndarray, type: str) -> np.ndarr
     return out
 
 
-@numba.njit(fastmath=True, cache=False)
-def _plain_level(cumulative, t0, m, count):
-    a = cumulative[t0 : t0 + count]
-    b = cumulative[t0 + m : t0 + m + count]
-    c = cumulative[t0 + 2 * m : t0 + 2 * m + count]
-    total = 0.0
-    for i in range(count):
-        d = (c[i] - b[i]) - (b[i] - a[i])
-        total += d * d
-    return total
-
-
 @numba.njit(parallel=True, cache=False)
 def _plain_floor_sums(cumulative, factors, block):
     n = cumulative.shape[0] - 1
@@ -81,7 +70,7 @@ def _plain_floor_sums(cumulative, factors, block):
         for k in range(factors.shape[0]):
             count = min(block, n - 2 * factors[k] + 1 - j * block)
             if count > 0:
-                out[j, k] = _plain_level(cumulative, j * block, factors[k], count)
+                out[j, k] = plain_squares(cumulative, j * block, factors[k], count)
     return out.sum(axis=0)
 
 
