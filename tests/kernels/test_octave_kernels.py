@@ -242,10 +242,10 @@ def test_sweep_steps_and_chained_squares_match_exact_arithmetic(dtype, count):
 
 
 @pytest.mark.parametrize("name", ["white", "offset", "drift", "random walk", "step"])
-def test_far_levels_exact_with_plain_steps_exact_steps_or_either(name):
+def test_far_levels_exact_with_local_prefixes_exact_steps_or_either(name):
     """The large levels (residue classes, pieces of ``fine`` samples): exact against Fractions
-    whether every piece keeps its plain steps (tol = inf), takes the once-rounded steps
-    (tol = 0) or is certified piece by piece (the default)."""
+    whether every piece keeps its plain local prefixes (tol = inf), takes the once-rounded
+    steps (tol = 0) or is certified piece by piece (the default)."""
     n = 3000
     x = np.random.default_rng(4).standard_normal(n) if name == "white" else adversarial(n)[name]
     factors = np.array([1, 2, 256, 512, 1024], dtype=np.int64)  # near=256: three large levels
@@ -258,16 +258,17 @@ def test_far_levels_exact_with_plain_steps_exact_steps_or_either(name):
 
 @pytest.mark.parametrize("dtype", [np.float64, np.float32, np.int16])
 @pytest.mark.parametrize("name", ["white", "offset", "drift", "random walk", "step", "periodic"])
-def test_plain_steps_err_within_their_certified_bound(name, dtype):
-    """Every running sum of the plain steps' errors (against Fractions) is within
-    :func:`step_error_bound` of the samples' distance from the centre. Noise is certified
-    by it, also on a large offset (the distance is from the centre); a period dividing
-    ``m`` far above the noise is not (``D`` is then only the noise), so such pieces take
-    the once-rounded steps."""
-    from avar._kernels.far import chained_squares, plain_second_differences, step_error_bound
+def test_local_prefixes_err_within_their_certified_bound(name, dtype):
+    """Every value of a plain local prefix (against Fractions) is within
+    :func:`prefix_error_bound`, and the sum of squares of the differences built from three
+    of them is within the bound :func:`certified` derives from
+    :func:`difference_error_bound`. Noise is certified, also on a large offset (the
+    prefixes are of the centred samples); a period dividing ``m`` far above the noise is
+    not (``D`` is then only the noise), so such pieces take the once-rounded steps."""
+    from avar._kernels.far import difference_error_bound, local_prefix, prefix_error_bound, prefix_squares
     from avar._kernels.streaming import CERTIFY_TOL, certified
 
-    n, m, t0, count = 3000, 512, 123, 900
+    n, m, t0, count = 3000, 512, 123, 500
     rng = np.random.default_rng(6)
     if name == "white":
         base = rng.standard_normal(n)
@@ -277,20 +278,40 @@ def test_plain_steps_err_within_their_certified_bound(name, dtype):
         base = adversarial(n)[name]
     x = np.round(base * 100).astype(dtype) if dtype == np.int16 else base.astype(dtype)
     centre = float(np.mean(x.astype(np.float64)))
-    steps = np.empty(count)
-    plain_second_differences(x[None, :], 0, t0, m, count, 1.0, steps)
     v = [Fraction(float(a)) for a in x]
-    error, worst = Fraction(0), 0.0
-    for i in range(count - 1):
-        error += Fraction(float(steps[i])) - (v[t0 + i + 2 * m] - 2 * v[t0 + i + m] + v[t0 + i])
-        worst = max(worst, abs(float(error)))
-    r = [float(np.max(np.abs(x[t0 + j * m : t0 + j * m + count].astype(np.float64) - centre))) for j in range(3)]
-    bound = step_error_bound(r[0], r[1], r[2], count)
-    assert worst <= bound
+    c = Fraction(centre)
+    prefixes, errors, bigs = [], 0.0, 0.0
+    for j in range(3):
+        start = t0 + j * m
+        out = np.full(count + 1, np.nan)
+        big = local_prefix(x[None, :], 0, start, count, centre, 1.0, out)
+        spread = float(np.max(np.abs(x[start : start + count].astype(np.float64) - centre)))
+        bound = prefix_error_bound(count, spread, big)
+        exact_prefix = Fraction(0)
+        for i in range(count + 1):
+            assert abs(Fraction(float(out[i])) - exact_prefix) <= bound, (j, i)
+            exact_prefix += v[start + i] - c if i < count else 0
+        prefixes.append(out)
+        errors += (2.0 if j == 1 else 1.0) * bound
+        bigs += (2.0 if j == 1 else 1.0) * big
+    s = [sum(v[: t0 + j * m], Fraction(0)) - (t0 + j * m) * c for j in range(3)]
+    d0 = s[2] - 2 * s[1] + s[0]
+    base_hi = float(d0)
+    base_lo = float(d0 - Fraction(base_hi))
+    total = prefix_squares(prefixes[0], prefixes[1], prefixes[2], base_hi, base_lo, count)
+    want = sum((d0 + Fraction(float(prefixes[2][i])) - 2 * Fraction(float(prefixes[1][i]))
+                + Fraction(float(prefixes[0][i]))) ** 2 for i in range(count))
+    steps = [v[t0 + i + 2 * m] - 2 * v[t0 + i + m] + v[t0 + i] for i in range(count)]
+    d, exact_total = d0, Fraction(0)
+    for i in range(count):
+        exact_total += d * d
+        d += steps[i]
+    delta = difference_error_bound(errors, bigs, base_hi, base_lo, 0.0)
+    bound = 2.0 * delta * np.sqrt(count * total) + count * delta**2 + 2 * count * 2.0**-53 * total
+    assert abs(float(exact_total) - total) <= bound
+    assert abs(float(want) - total) <= 2 * count * 2.0**-53 * total  # the sum itself: plain rounding only
     if dtype == np.float64 and name in ("white", "offset", "periodic"):
-        d0 = float(sum(v[t0 + 2 * m - j] - v[t0 + m - j] for j in range(1, m + 1)))
-        total = chained_squares(d0, steps, count)
-        assert certified(total, bound, count, CERTIFY_TOL) == (name != "periodic")
+        assert certified(total, delta, count, CERTIFY_TOL) == (name != "periodic")
 
 
 def test_second_differences_scale_extreme_samples_before_rounding():

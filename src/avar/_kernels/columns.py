@@ -109,7 +109,7 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
         chunk = _chunk(n_diff[0], block, SWEEP_CHUNK) if chunk is None else chunk
         sums[:, :n_small] = sweep_sums(data, centre, scale, factors[:n_small], n_diff[:n_small], block, chunk)
     if n_small < factors.shape[0]:
-        sums[:, n_small:] = far_sums(data.T, scale, th, tl, spread, factors[n_small:], n_diff[n_small:], fine, tol)
+        sums[:, n_small:] = far_sums(data.T, scale, centre, th, tl, spread, factors[n_small:], n_diff[n_small:], fine, tol)
     return _finish(sums, scale, factors, n_diff.astype(np.float64))
 
 

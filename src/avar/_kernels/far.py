@@ -4,38 +4,35 @@ For a cluster size ``m`` the differences are ``D_t = S[t+2m] - 2 S[t+m] + S[t]``
 (``S`` the centred cumulative sum). For ``m`` a multiple of the table's
 granularity ``F`` (:data:`SWEEP_FINE` samples; the table holds the exact
 double-double ``S`` at every multiple of ``F``), time is cut into pieces of
-``F`` samples and each piece runs the recurrence
+``F`` samples. A piece's *local prefix* ``L[i] = sum_{s<i} (x[p+s] sc - c)``
+(plain float64, :func:`local_prefix`) is computed once, and every level that
+reads the piece takes its differences elementwise from three of them:
 
-    D_{t0} = S[t0+2m] - 2 S[t0+m] + S[t0]   (exact double-double, from the table)
-    D_{t+1} = D_t + (x[t+2m] - 2 x[t+m] + x[t])
+    D_{t0+i} = (S[t0+2m] - 2 S[t0+m] + S[t0]) + (L2[i] - 2 L1[i] + L0[i])
 
-The running value is ``D`` itself, never a cumulative sum, so every addition
-errs by at most ``u |D|`` (u = 2**-53): each ``D`` errs by at most about
-``F u max |D|`` (1e-13 for the default piece) plus the error of its steps,
-whatever the offset or the excursion of ``S``. :func:`chained_squares` runs a
-piece as :data:`CHAINS` independent stretches so the additions do not wait on
-one another.
+with the first term exact (double-double, from the table). No level runs a
+recurrence of its own, so every level is one vectorized pass
+(:func:`prefix_squares`).
 
-The steps are first taken in plain float64,
-``(x[t+2m] - x[t+m]) - (x[t+m] - x[t])`` (:func:`plain_second_differences`);
-the table's spread of each piece (how far its samples lie from the centre)
-bounds their accumulated error (:func:`step_error_bound`). A piece whose bound
-could move its sum of squares by more than the tolerance
-(:func:`avar._kernels.streaming.certified`, 1e-11 relative) is redone with
-every step rounded once (:func:`second_differences`, TwoSum). Noise-like data
-pass, also on a large offset (the spread is measured from the centre); a
-piece whose ``D`` is tiny against its samples' spread (a strong component
-periodic in ``m``, say) takes the exact steps.
+Certified, else exact: a local prefix errs by at most ``1.01 u F (r + B)``
+(u = 2**-53; ``r`` the table's spread of the piece, how far its samples lie
+from the centre; ``B`` the largest ``|L|``). That bounds the error of every
+``D`` of a piece (:func:`difference_error_bound`), and so of its sum of
+squares (:func:`avar._kernels.streaming.certified`, 1e-11 relative). A piece
+that fails (a ``D`` tiny against its samples' excursion: a component periodic
+in ``m`` far above the noise, say) is redone with its steps
+``x[t+2m] - 2 x[t+m] + x[t]`` each rounded once (:func:`second_differences`,
+TwoSum) driving the running ``D`` (:func:`chained_squares`): each addition
+then errs by at most ``u |D|``, whatever the offset or the excursion of ``S``.
+64-bit integers (not exact in one float64) always take that path.
 
 Order of work: a level reads the pieces at ``t``, ``t + m`` and ``t + 2m``. All
 large ``m`` are multiples of the smallest, ``P``, so those pieces are in the
 same residue class modulo ``P``. A task takes one class (every ``P / F``-th
-piece) and, piece by piece, every level: the pieces it reads for one level
-are read again by the next levels and by its later pieces while they are
-still in the cache, instead of once per level from memory (the input read in
-time order meets each sample again only 2m samples later, long evicted).
-The sums of the tasks are added in a fixed order, so the bits do not depend
-on the number of threads.
+piece), keeps the local prefixes of the pieces its levels still read in a ring,
+and, piece by piece, runs every level: each prefix is computed once and read
+about twice per level while it is still in the cache. The sums of the tasks
+are added in a fixed order, so the bits do not depend on the number of threads.
 """
 
 from __future__ import annotations
@@ -180,48 +177,133 @@ def _base(th, tl, col, k0, k1, k2):
 
 
 @njit(cache=True)
-def plain_second_differences(rows, col, t0, m, count, sc, out):
-    """Plain float64 steps ``out[i] = (x2 sc - x1 sc) - (x1 sc - x0 sc)`` with
-    ``x_j = x[t0 + i + j m]``, for ``i < count - 1``; ``out[count - 1] = 0``.
+def local_prefix(rows, col, start, count, centre, sc, out):
+    """``out[i] = sum_{s<i} (x[start+s] sc - centre)`` in plain float64 for ``i < count``
+    (and ``i = count`` when ``out`` is longer: a last, short piece is read up to its end).
 
-    Each of the three subtractions errs by at most ``u`` times its exact result
-    (u = 2**-53; the power-of-two ``sc`` is exact), so for any centre ``c`` a step
-    errs by at most ``u (|x2 - x1| + |x1 - x0| + (1 + u)(|x2 - x1| + |x1 - x0|))
-    <= 2.01 u (r2 + 2 r1 + r0)`` where ``r_j >= |x_j sc - c|`` (:func:`step_error_bound`).
-    Differences of near samples are exact (Sterbenz). Elementwise: LLVM vectorizes
-    it, at about two thirds the cost of :func:`second_differences`. Not for 64-bit
-    integers (not exact in one float64).
+    Returns ``B``, the largest ``|partial sum|``. Each stored value errs by at most
+    ``count u (r + B)`` with ``r >= |x sc - centre|`` over the piece: one rounding of
+    each centred sample and of each partial sum (:func:`difference_error_bound`).
+    Not for 64-bit integers (not exact in one float64).
     """
-    x0 = rows[col, t0 : t0 + count - 1]
-    x1 = rows[col, t0 + m : t0 + m + count - 1]
-    x2 = rows[col, t0 + 2 * m : t0 + 2 * m + count - 1]
-    g = out[: count - 1]
-    for i in range(count - 1):
-        a = np.float64(x2[i]) * sc - np.float64(x1[i]) * sc
-        b = np.float64(x1[i]) * sc - np.float64(x0[i]) * sc
-        g[i] = a - b
-    out[count - 1] = 0.0
-
-
-@njit(cache=True, inline="always")
-def step_error_bound(r0, r1, r2, count):
-    """Bound on the accumulated error of ``count`` steps of :func:`plain_second_differences`
-    whose samples ``x_j`` lie within ``r_j`` of a common centre:
-    ``2.5 u count (r2 + 2 r1 + r0)`` (2.01 per step, rounded up generously)."""
-    return 2.5 * _EPS * count * (r2 + 2.0 * r1 + r0)
+    x = rows[col, start : start + count]
+    o = out[:count]
+    total = 0.0
+    big = 0.0
+    for i in range(count):
+        o[i] = total
+        total += np.float64(x[i]) * sc - centre
+        big = max(big, abs(total))
+    if count < out.shape[0]:
+        out[count] = total
+    return big
 
 
 @njit(cache=True)
-def far_task(rows, col, first, stride, sc, th, tl, spread, factors, nd, fine, tol, out_row):
+def fill_prefixes(rows, col, first, stride, fine, centre, sc, at, out, bigs):
+    """:func:`local_prefix` of the four whole pieces ``first + g stride`` (g < 4) into the ring
+    rows ``(at + g) % len(out)``, and their ``B`` into ``bigs``: the same operations in the
+    same order per piece, interleaved so that the four running sums do not wait on one another."""
+    ring = out.shape[0]
+    a0 = first * fine
+    x0 = rows[col, a0 : a0 + fine]
+    x1 = rows[col, a0 + stride * fine : a0 + stride * fine + fine]
+    x2 = rows[col, a0 + 2 * stride * fine : a0 + 2 * stride * fine + fine]
+    x3 = rows[col, a0 + 3 * stride * fine : a0 + 3 * stride * fine + fine]
+    o0 = out[at % ring]
+    o1 = out[(at + 1) % ring]
+    o2 = out[(at + 2) % ring]
+    o3 = out[(at + 3) % ring]
+    t0 = t1 = t2 = t3 = 0.0
+    b0 = b1 = b2 = b3 = 0.0
+    for i in range(fine):
+        o0[i] = t0
+        o1[i] = t1
+        o2[i] = t2
+        o3[i] = t3
+        t0 += np.float64(x0[i]) * sc - centre
+        t1 += np.float64(x1[i]) * sc - centre
+        t2 += np.float64(x2[i]) * sc - centre
+        t3 += np.float64(x3[i]) * sc - centre
+        b0 = max(b0, abs(t0))
+        b1 = max(b1, abs(t1))
+        b2 = max(b2, abs(t2))
+        b3 = max(b3, abs(t3))
+    bigs[at % ring] = b0
+    bigs[(at + 1) % ring] = b1
+    bigs[(at + 2) % ring] = b2
+    bigs[(at + 3) % ring] = b3
+
+
+@njit(cache=True, fastmath={"reassoc", "contract"})
+def prefix_squares(p0, p1, p2, base_hi, base_lo, count):
+    """Sum over ``i < count`` of ``D_i**2``, ``D_i = base + (p2[i] - 2 p1[i] + p0[i])`` (vectorized).
+
+    Any association of the six terms is allowed (``reassoc``): :func:`difference_error_bound`
+    bounds every one of them.
+    """
+    a = p0[:count]
+    b = p1[:count]
+    c = p2[:count]
+    total = 0.0
+    for i in range(count):
+        d = (base_hi + ((c[i] - b[i]) - (b[i] - a[i]))) + base_lo
+        total += d * d
+    return total
+
+
+@njit(cache=True, inline="always")
+def prefix_error_bound(count, spread, big):
+    """Bound on the error of every value of :func:`local_prefix`: ``1.01 u count (r + B)``."""
+    return 1.01 * _EPS * count * (spread + big)
+
+
+@njit(cache=True, inline="always")
+def difference_error_bound(errors, bigs, base_hi, base_lo, table_mag):
+    """Bound on the error of every ``D`` of :func:`prefix_squares`.
+
+    ``errors`` and ``bigs``: the three prefixes' :func:`prefix_error_bound` and ``B``,
+    weighted ``(1, 2, 1)``; then at most five roundings, each of at most ``u`` times the
+    sum of the terms' magnitudes (whatever their order), and the table's double-double
+    error (``8 u**2`` of the weighted ``|S|``).
+    """
+    return errors + 5.05 * _EPS * (abs(base_hi) + abs(base_lo) + bigs) + 8.0 * _EPS * _EPS * table_mag
+
+
+@njit(cache=True)
+def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, fine, tol, out_row):
     """Adds to ``out_row`` the sums of ``D**2`` of every level over the pieces
     ``first, first + stride, ...`` (pieces of ``fine`` samples, level ``k`` its
     differences ``0 .. nd[k] - 1``). ``spread[col, q]`` bounds ``|x sc - centre|`` over piece ``q``."""
-    steps = np.empty(fine)
+    n = rows.shape[1]
+    n_levels = factors.shape[0]
+    reach = 2 * (factors[n_levels - 1] // factors[0])  # farthest piece a level reads, in class steps
+    ring = reach + 5  # the pieces a level reads, and up to three more filled ahead
     wide = _is_wide(rows[col, 0])  # 64-bit integers: every step exact from the start
-    q = first
-    while q * fine < nd[0]:
+    prefixes = np.empty((0 if wide else ring, fine))
+    errors = np.empty(ring)
+    bigs = np.empty(ring)
+    steps = np.empty(fine)
+    ready = 0  # class steps whose local prefix is in the ring
+    j = 0
+    while (first + stride * j) * fine < nd[0]:
+        q = first + stride * j
         t0 = q * fine
-        for k in range(factors.shape[0]):
+        while not wide and ready <= j + reach and (first + stride * ready) * fine < n:
+            p = first + stride * ready
+            if (p + 3 * stride + 1) * fine <= n:  # four whole pieces, their sums interleaved
+                fill_prefixes(rows, col, p, stride, fine, centre, sc, ready, prefixes, bigs)
+                for g in range(4):
+                    slot = (ready + g) % ring
+                    errors[slot] = prefix_error_bound(fine, spread[col, p + g * stride], bigs[slot])
+                ready += 4
+                continue
+            count = min(fine, n - p * fine)
+            slot = ready % ring
+            bigs[slot] = local_prefix(rows, col, p * fine, count, centre, sc, prefixes[slot])
+            errors[slot] = prefix_error_bound(count, spread[col, p], bigs[slot])
+            ready += 1
+        for k in range(n_levels):
             cnt = min(fine, nd[k] - t0)
             if cnt <= 0:
                 break  # larger levels have fewer differences
@@ -229,30 +311,33 @@ def far_task(rows, col, first, stride, sc, th, tl, spread, factors, nd, fine, to
             o = m // fine
             ch, cl = _base(th, tl, col, q, q + o, q + 2 * o)
             if not wide:
-                plain_second_differences(rows, col, t0, m, cnt, sc, steps)
-                total = chained_squares(ch + cl, steps, cnt)
-                delta = step_error_bound(spread[col, q], spread[col, q + o], spread[col, q + 2 * o], cnt)
+                h = o // stride
+                s0, s1, s2 = j % ring, (j + h) % ring, (j + 2 * h) % ring
+                total = prefix_squares(prefixes[s0], prefixes[s1], prefixes[s2], ch, cl, cnt)
+                table_mag = abs(th[col, q]) + 2.0 * abs(th[col, q + o]) + abs(th[col, q + 2 * o])
+                delta = difference_error_bound(errors[s0] + 2.0 * errors[s1] + errors[s2],
+                                               bigs[s0] + 2.0 * bigs[s1] + bigs[s2], ch, cl, table_mag)
                 if certified(total, delta, cnt, tol):
                     out_row[k] += total
                     continue
             second_differences(rows, col, t0, m, cnt, sc, steps)
             out_row[k] += chained_squares(ch + cl, steps, cnt)
-        q += stride
+        j += 1
 
 
 @njit(cache=True, parallel=True)
-def far_sums(rows, scale, th, tl, spread, factors, nd, fine, tol=CERTIFY_TOL):
+def far_sums(rows, scale, centre, th, tl, spread, factors, nd, fine, tol=CERTIFY_TOL):
     """Sums of ``D**2`` per (column, level), shape (C, L), for ``factors`` strictly
     increasing multiples of the smallest, itself a multiple of ``fine``; ``nd`` the
     numbers of differences (all > 0). ``rows``: the input transposed (C, N);
-    ``th, tl, spread``: :func:`avar._kernels.streaming.block_table` at granularity ``fine``."""
+    ``th, tl, centre, spread``: :func:`avar._kernels.streaming.block_table` at granularity ``fine``."""
     channels = rows.shape[0]
     classes = factors[0] // fine
     out = np.zeros((channels, classes, factors.shape[0]))
     for task in prange(channels * classes):
         c = task // classes
         a = task % classes
-        far_task(rows, c, a, classes, scale[c], th, tl, spread, factors, nd, fine, tol, out[c, a])
+        far_task(rows, c, a, classes, scale[c], centre[c], th, tl, spread, factors, nd, fine, tol, out[c, a])
     result = np.zeros((channels, factors.shape[0]))
     for c in range(channels):
         for a in range(classes):
