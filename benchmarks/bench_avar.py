@@ -19,7 +19,10 @@ cumulative sum already in memory, the least work of any method built on it.
 Memory: a fresh process creates the 1e8-sample input (float64, then float32)
 without a temporary, runs the octave "mo" ``avar.avar`` on it and reports
 its VmHWM (peak resident set) minus the input size ("extra": interpreter,
-libraries, compiled kernels and the workspace). ``--huge`` writes a 1e9-sample
+libraries, compiled kernels and the workspace). A separate process first
+fills numba's on-disk cache, so that the one-time compilation of a fresh
+install (about 110 MB of LLVM at its peak) is not counted as the
+computation's memory. ``--huge`` writes a 1e9-sample
 float32 ``.npy`` in a temporary directory and runs ``avar.avar`` on its
 memory map in a fresh process, sampling RssAnon (anonymous memory: the
 mapped file's pages are page cache, not the process's) every 0.1 s.
@@ -118,6 +121,8 @@ print(elapsed, int(status["VmHWM"].split()[0]), x.nbytes)
 def peak_memory(n: int, dtype: str, type: str = "mo") -> tuple[float, float, float]:
     """(seconds, VmHWM MB, input MB) of a fresh process computing the octave AV of n samples."""
     code = textwrap.dedent(MEMORY.format(n=n, dtype=dtype, type=type))
+    warm = textwrap.dedent(MEMORY.format(n=300_000, dtype=dtype, type=type))  # fills numba's cache
+    subprocess.run([sys.executable, "-c", warm], capture_output=True, check=True)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     return float(out[0]), int(out[1]) / 1024, int(out[2]) / 1024**2
 
