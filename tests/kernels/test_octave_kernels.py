@@ -252,8 +252,9 @@ def test_far_levels_exact_with_local_prefixes_exact_steps_or_either(name):
     want = exact(x, factors, "mo")
     for tol in (np.inf, 0.0, None):
         extra = {} if tol is None else {"tol": tol}
-        got = run(x, factors, "mo", **TINY["mo"], **extra)[0]
-        np.testing.assert_allclose(got, want, rtol=1e-10, atol=0, err_msg=f"tol={tol}")
+        for span in (2, 512):  # span=2: the large levels in groups of two and one
+            got = run(x, factors, "mo", **TINY["mo"], **extra, span=span)[0]
+            np.testing.assert_allclose(got, want, rtol=1e-10, atol=0, err_msg=f"tol={tol}, span={span}")
 
 
 @pytest.mark.parametrize("dtype", [np.float64, np.float32, np.int16])

@@ -8,7 +8,7 @@ import numba
 import numpy as np
 from numba import njit
 
-from avar._kernels.far import SWEEP_FINE, far_sums
+from avar._kernels.far import FAR_SPAN, SWEEP_FINE, far_sums
 from avar._kernels.haar import CHUNK_BLOCKS as HAAR_CHUNK
 from avar._kernels.haar import PYRAMID_EXP, haar_sums
 from avar._kernels.levels import level_sums
@@ -97,10 +97,12 @@ def run_haar(data, factors, n_diff, exp=PYRAMID_EXP, chunk=None):
 
 
 def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=None, fine=SWEEP_FINE,
-              tol=CERTIFY_TOL):
+              tol=CERTIFY_TOL, span=FAR_SPAN):
     """"mo" at power-of-two cluster sizes ``factors`` (increasing): the levels below ``near``
     by the cache-blocked sweep (:mod:`avar._kernels.sweep`), the others by residue class
-    (:mod:`avar._kernels.far`, table granularity ``fine``, certification tolerance ``tol``)."""
+    (:mod:`avar._kernels.far`, table granularity ``fine``, certification tolerance ``tol``),
+    in groups whose largest factor is at most ``span`` times their smallest (a task's ring
+    of local prefixes holds ``2 span + 5`` pieces: 8 MB by default, whatever N)."""
     n_small = int(np.searchsorted(factors, near))
     fine = min(fine, int(factors[n_small])) if n_small < factors.shape[0] else fine
     th, tl, centre, scale, spread = _table(data, fine)
@@ -108,8 +110,12 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
     if n_small > 0:
         chunk = _chunk(n_diff[0], block, SWEEP_CHUNK) if chunk is None else chunk
         sums[:, :n_small] = sweep_sums(data, centre, scale, factors[:n_small], n_diff[:n_small], block, chunk)
-    if n_small < factors.shape[0]:
-        sums[:, n_small:] = far_sums(data.T, scale, centre, th, tl, spread, factors[n_small:], n_diff[n_small:], fine, tol)
+    start = n_small
+    while start < factors.shape[0]:
+        stop = int(np.searchsorted(factors, factors[start] * span, side="right"))
+        sums[:, start:stop] = far_sums(data.T, scale, centre, th, tl, spread, factors[start:stop], n_diff[start:stop],
+                                       fine, tol)
+        start = stop
     return _finish(sums, scale, factors, n_diff.astype(np.float64))
 
 

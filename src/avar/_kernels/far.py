@@ -47,6 +47,10 @@ from avar._kernels.streaming import _EPS, CERTIFY_TOL, _two_sum, certified
 #: Samples per piece: the table's granularity for the large levels and the steps summed per call.
 SWEEP_FINE = 1 << 10
 
+#: Largest ratio of the largest to the smallest factor of one :func:`far_sums` call: a task's
+#: ring then holds at most ``2 FAR_SPAN + 5`` local prefixes (8 MB), however long the series.
+FAR_SPAN = 1 << 9
+
 
 def _second_difference(x2, x1, x0, sc):  # pragma: no cover - replaced by the overload in compiled code
     raise NotImplementedError
