@@ -44,7 +44,7 @@ from numba.extending import overload
 from avar._kernels.haar import _is_wide, _pair
 from avar._kernels.streaming import _EPS, CERTIFY_TOL, _two_sum, certified
 
-#: Samples per piece: the table's granularity for the large levels and the steps summed per call.
+#: Samples per piece: the table's granularity for the large levels and the length of a local prefix.
 SWEEP_FINE = 1 << 10
 
 #: Largest ratio of the largest to the smallest factor of one :func:`far_sums` call: a task's

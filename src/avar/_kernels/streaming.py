@@ -172,7 +172,8 @@ def block_table(data, scale, integral, block=BLOCK):
     ``table_*`` have shape (C, ceil(N / block) + 1) with the centred
     cumulative sum of ``data * scale`` at every block boundary (and at N);
     ``spread`` (C, ceil(N / block)) bounds ``|x * scale - centre|`` over each
-    block (rounded up: it bounds the rounding of plain differences of samples).
+    block (rounded up: it bounds the rounding of the plain local prefix sums of
+    :mod:`avar._kernels.far`).
     """
     n, channels = data.shape
     nb = (n + block - 1) // block
