@@ -227,8 +227,8 @@ class WN(Process):
         AD(tau) = sigma / sqrt(tau) and, with tau = m / f, sigma^2 / tau =
         sigma2 / m give ``sigma2 = sigma^2 f``.
 
-        >>> WN.from_continuous(0.1, 100.0)
-        WN(sigma2=1.0000000000000002)
+        >>> round(WN.from_continuous(0.1, 100.0).sigma2, 10)
+        1.0
         """
         return cls(sigma2=check_real(sigma, "sigma") ** 2 * check_freq(freq))
 

@@ -96,7 +96,7 @@ def greenhall_edf(alpha: Any, d: int, m: Any, n_phase: int, overlapping: bool, m
     their neighbours, so edf = 2 M**2 / (3 M - 1) = 162 / 26 exactly:
 
     >>> float(greenhall_edf(0, 2, 100, 1001, overlapping=False, modified=False))
-    6.23076923076923...
+    6.230769231...
     >>> greenhall_edf([2, 0, -2], 2, 8, 1001, overlapping=True, modified=True).round(2)
     array([154.38, 118.87,  94.19])
     >>> greenhall_edf(0, 3, [1, 10, 100], 1001, overlapping=True, modified=False).round(2)
