@@ -23,6 +23,7 @@ _EXPORTS = {
     "RW": "avar.models.processes",
     "WN": "avar.models.processes",
     "FN": "avar.models.flicker",
+    "SIN": "avar.models.sinusoid",
     "CompositeModel": "avar.models.processes",
     "NoiseModel": "avar.models.processes",
     "av_ar1": "avar.models.theory",

@@ -52,7 +52,8 @@ def test_one_command_writes_yaml_figure_and_table(imu_file, tmp_path):
     assert fields["accelerometer_noise_density"] == pytest.approx(2e-5 * 9.80665, rel=0.03)
     assert png.read_bytes()[:8] == PNG_MAGIC
     table = pd.read_csv(csv)
-    assert len(table) == 6 * 5 and set(table["Channel"]) == {"gx", "gy", "gz", "ax", "ay", "az"}
+    ieee = table[table["Process"].isin(["QN", "WN", "FN", "RW", "DR", "MIN"])]
+    assert len(ieee) == 6 * 6 and set(table["Channel"]) == {"gx", "gy", "gz", "ax", "ay", "az"}
     wn = table[(table["Channel"] == "gx") & (table["Process"] == "WN")].iloc[0]
     assert wn["Customary"] == pytest.approx(3e-3 * 60, rel=0.03)  # deg/sqrt(h)
     absent = table[table["Status"] == "absent"]
@@ -89,3 +90,58 @@ def test_errors_are_one_line(tmp_path):
     assert result.returncode == 2
     result = run(str(tmp_path / "missing.csv"), "--freq", "100")
     assert result.returncode == 1 and "no such file" in result.stderr
+
+
+def test_curves_minimum_rows_and_kalibr_without_a_random_walk(tmp_path):
+    """White noise alone: the random walk is not resolved, yet --kalibr writes every key (its bound, marked)."""
+    n = int(600 * FREQ)
+    rng = np.random.default_rng(8)
+    frame = pd.DataFrame({"time": np.arange(n) / FREQ, "gx": 0.01 * rng.standard_normal(n),
+                          "ax": 0.002 * rng.standard_normal(n)})
+    log = tmp_path / "white.csv"
+    frame.to_csv(log, index=False)
+    yaml_path, curves, terms = tmp_path / "imu.yaml", tmp_path / "curves.csv", tmp_path / "terms.csv"
+    result = run(str(log), "--kalibr", str(yaml_path), "--curves", str(curves), "--output", str(terms),
+                 "--kalibr-axis", "mean")
+    assert result.returncode == 0, result.stderr
+    text = yaml_path.read_text()
+    fields = yaml.safe_load(text)
+    assert set(fields) == {"gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
+                           "accelerometer_random_walk", "rostopic", "update_rate"}
+    assert all(isinstance(fields[k], float) and fields[k] > 0 for k in fields if k != "rostopic")
+    assert text.count("95 % upper bound") >= 2 and "mean over the axes" in text
+    assert fields["gyroscope_noise_density"] == pytest.approx(0.01 / math.sqrt(FREQ), rel=0.05)
+    table = pd.read_csv(curves)
+    assert list(table.columns[:6]) == ["Channel", "Tau (s)", "ADEV", "Lower", "Upper", "Implied ADEV"]
+    assert set(table["Channel"]) == {"gx", "ax"} and (table["Lower"] <= table["ADEV"]).all()
+    assert (table["ADEV"] <= table["Upper"]).all()
+    rows = pd.read_csv(terms)
+    minimum = rows[rows["Term"].str.contains("minimum")]
+    assert list(minimum["Channel"]) == ["gx", "ax"]
+    for _, row in minimum.iterrows():
+        own = table[table["Channel"] == row["Channel"]]
+        assert row["Value"] == pytest.approx(own["ADEV"].min(), rel=1e-9)  # SI: rad/s and m/s^2 by default
+        assert row["Tau (s)"] == pytest.approx(float(own.loc[own["ADEV"].idxmin(), "Tau (s)"]))
+
+
+def test_wrong_units_are_named(tmp_path):
+    """deg/s gyros and g accelerometers read with the default SI units: each mistake is named with its flag."""
+    n = int(600 * FREQ)
+    rng = np.random.default_rng(9)
+    frame = pd.DataFrame({"time": np.arange(n) / FREQ,
+                          "gx": 0.03 * math.sqrt(FREQ) * rng.standard_normal(n),  # 1.8 deg/sqrt(h) in deg/s
+                          "az": -1.0 + 0.002 * rng.standard_normal(n)})            # gravity in g
+    log = tmp_path / "units.csv"
+    frame.to_csv(log, index=False)
+    result = run(str(log))
+    assert result.returncode == 0, result.stderr
+    assert "--gyro-units deg/s" in result.stderr and "--accel-units g" in result.stderr
+    right = run(str(log), "--gyro-units", "deg/s", "--accel-units", "g")
+    assert right.returncode == 0 and "--gyro-units" not in right.stderr and "--accel-units" not in right.stderr
+
+
+def test_bag_units_must_be_si(tmp_path):
+    bag = tmp_path / "log.bag"
+    bag.write_bytes(b"")
+    result = run(str(bag), "--gyro-units", "deg/s")
+    assert result.returncode == 2 and "SI units" in result.stderr and "--gyro-units" in result.stderr

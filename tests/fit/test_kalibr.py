@@ -41,7 +41,7 @@ def report(recording):
 
 
 def test_kalibr_yaml_holds_the_simulated_densities_in_si(report, tmp_path):
-    path = report.to_kalibr(tmp_path / "imu.yaml")
+    path = report.to_kalibr(tmp_path / "imu.yaml", axis="mean")  # the axes share one truth
     fields = yaml.safe_load(path.read_text())
     assert list(fields) == ["gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
                             "accelerometer_random_walk", "rostopic", "update_rate"]
@@ -53,12 +53,27 @@ def test_kalibr_yaml_holds_the_simulated_densities_in_si(report, tmp_path):
     assert fields["update_rate"] == 100.0
 
 
-def test_densities_are_the_mean_over_axes(report):
-    fields = report.kalibr()
+def test_densities_are_the_largest_axis_or_the_mean(report):
     gyro_wn = [report.value(f"gyro_{a}", "WN") for a in "xyz"]
-    assert fields["gyroscope_noise_density"] == pytest.approx(np.mean(gyro_wn), rel=1e-14)
     acc_rw = [report.value(f"acc_{a}", "RW") for a in "xyz"]
-    assert fields["accelerometer_random_walk"] == pytest.approx(np.mean(acc_rw), rel=1e-14)
+    largest, mean = report.kalibr(), report.kalibr(axis="mean")
+    assert largest["gyroscope_noise_density"] == max(gyro_wn)
+    assert largest["accelerometer_random_walk"] == max(acc_rw)
+    assert mean["gyroscope_noise_density"] == pytest.approx(np.mean(gyro_wn), rel=1e-14)
+    assert mean["accelerometer_random_walk"] == pytest.approx(np.mean(acc_rw), rel=1e-14)
+    with pytest.raises(ValueError, match="axis"):
+        report.kalibr(axis="median")
+
+
+def test_every_axis_is_named_in_a_comment_above_its_density(report, tmp_path):
+    text = report.to_kalibr(tmp_path / "imu.yaml").read_text()
+    lines = text.splitlines()
+    for key, process, prefix in (("gyroscope_noise_density", "WN", "gyro"), ("accelerometer_random_walk", "RW", "acc")):
+        at = next(k for k, line in enumerate(lines) if line.startswith(key + ":"))
+        comment = lines[at - 1]
+        assert comment.startswith("# largest over the axes:")
+        for axis in "xyz":
+            assert f"{prefix}_{axis} {report.value(f'{prefix}_{axis}', process):.4g}" in comment
 
 
 def test_topic_rate_and_overrides(report, recording, tmp_path):
@@ -82,11 +97,18 @@ def test_existing_file_is_refused_and_nothing_half_written(report, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["imu.yaml"]  # no temporary left behind
 
 
-def test_absent_random_walk_is_an_error_not_a_zero():
+def test_an_unresolved_random_walk_gives_its_bound_with_a_comment(tmp_path):
     x = WN(sigma2=1e-4).simulate(50_000, seed=1)
     rep = avar.noise_report(x, gyro_units="rad/s", freq=100.0)
-    with pytest.raises(ValueError, match="gyroscope_random_walk"):
-        rep.kalibr()
+    row = rep.table.set_index("Process").loc["RW"]
+    assert row["Status"] == "bound" and row["Value"] is pd.NA
+    path = rep.to_kalibr(tmp_path / "imu.yaml")
+    fields = yaml.safe_load(path.read_text())
+    assert fields["gyroscope_random_walk"] == pytest.approx(float(row["Upper"]), rel=1e-12)
+    comment = path.read_text().splitlines()[3]
+    assert "x " in comment and "(95 % upper bound)" in comment and "not resolved on x" in comment
+    # a white noise of 1e-4 per sample at 100 Hz: no random walk, so the bound must be small but positive
+    assert 0 < fields["gyroscope_random_walk"] < 1e-3
     assert rep.kalibr(gyroscope_random_walk=1e-6)["gyroscope_random_walk"] == 1e-6
     with pytest.raises(ValueError, match="no gyroscope or accelerometer"):
         avar.noise_report(x, freq=100.0).kalibr()

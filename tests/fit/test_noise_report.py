@@ -11,6 +11,7 @@ import pytest
 
 import avar
 from avar.fit.noise_fit import FLICKER_FACTOR, fit_noise_terms, term_regressors
+from avar.fit.sensor_terms import FLICKER_AV_FACTOR
 from avar.models import FN, QN, RW, WN
 
 FREQ = 100.0
@@ -51,8 +52,9 @@ def test_customary_units_follow_ieee_952(report):
     assert table.loc["RW", "Customary"] == pytest.approx(k_si / DEG * 3600 * 60, rel=1e-12)
     assert list(table.loc[["WN", "FN", "RW"], "Customary unit"]) == ["deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)"]
     assert list(table.loc[["WN", "FN", "RW"], "Unit"]) == ["rad/s/sqrt(Hz)", "rad/s", "rad/s^2/sqrt(Hz)"]
-    assert list(table["Term"]) == ["Quantization", "Angle random walk", "Bias instability", "Rate random walk",
-                                   "Rate ramp"]
+    assert list(table["Term"]) == ["Quantization", "Angle random walk",
+                                   "Bias instability (IEEE 952 B, AD plateau = 0.664 B)", "Rate random walk",
+                                   "Rate ramp", "Allan deviation minimum (in-run bias stability)"]
 
 
 def test_units_of_the_data_only_rescale(gyro, report):
@@ -68,7 +70,7 @@ def test_absent_processes_are_absent_never_nan(report):
     absent = table[table["Status"] == "absent"]
     assert list(absent["Process"]) == ["QN", "DR"]
     assert all(v is pd.NA for v in absent["Value"])
-    present = table[table["Status"] == "present"]
+    present = table[table["Status"].isin(["present", "measured"])]
     values = present[["Value", "Lower", "Upper"]].to_numpy(dtype=float)
     assert np.all(np.isfinite(values)) and np.all(values[:, 1] < values[:, 0]) and np.all(values[:, 0] < values[:, 2])
     assert "absent" in str(report) and "nan" not in str(report).lower()
@@ -78,7 +80,10 @@ def test_white_noise_alone_reports_only_white_noise():
     x = WN(sigma2=1e-4).simulate(100_000, seed=2)
     rep = avar.noise_report(x, accel_units="m/s^2", freq=50.0)
     statuses = dict(zip(rep.table["Process"], rep.table["Status"]))
-    assert statuses == {"QN": "absent", "WN": "present", "FN": "absent", "RW": "absent", "DR": "absent"}
+    # the terms an engineer needs are bounded when the data do not show them; the others absent
+    assert statuses == {"QN": "absent", "WN": "present", "FN": "bound", "RW": "bound", "DR": "absent", "MIN": "measured"}
+    table = rep.table.set_index("Process")
+    assert table.loc["FN", "Value"] is pd.NA and table.loc["FN", "Upper"] > 0
     # sigma2 per sample = N^2 f
     assert rep.value("x", "WN") == pytest.approx(math.sqrt(1e-4 / 50.0), rel=0.01)
     assert list(rep.table["Term"])[1] == "Velocity random walk"
@@ -95,7 +100,7 @@ def test_quantization_is_found():
 def test_accelerometer_units(gyro):
     # the same numbers read as an accelerometer in g: SI = g0 times, ug = B[g] * 1e6
     rep = avar.noise_report(gyro, accel_units="g", freq=FREQ)
-    b_g = rep.fits["x"].coefficient("FN")
+    b_g = math.sqrt([c.scale for c in rep.fits["x"].components if c.kind == "FN"][0])
     assert rep.value("x", "FN") == pytest.approx(b_g * 9.80665, rel=1e-12)
     assert rep.value("x", "FN", customary=True) == pytest.approx(b_g * 1e6, rel=1e-12)
     assert rep.value("x", "WN", customary=True) == pytest.approx(rep.value("x", "WN") * 60, rel=1e-12)
@@ -103,12 +108,17 @@ def test_accelerometer_units(gyro):
     assert in_mg.value("x", "FN") == pytest.approx(rep.value("x", "FN"), rel=1e-9)
 
 
-def test_bias_instability_is_read_at_the_bottom_of_the_curve(report):
-    row = report.table.set_index("Process").loc["FN"]
-    av, fit = report.avs["x"], report.fits["x"]
-    model = fit.model_av(av.levels)
-    assert row["Tau (s)"] == av.levels[np.argmin(model)]
+def test_the_allan_deviation_minimum_is_the_empirical_one(report):
+    row = report.table.set_index("Process").loc["MIN"]
+    av = report.avs["x"]
+    at = int(np.argmin(av.adev))
+    assert row["Tau (s)"] == av.levels[at]
+    assert row["Value"] == pytest.approx(av.adev[at] * DEG, rel=1e-12)
+    assert row["Customary"] == pytest.approx(av.adev[at] * 3600, rel=1e-12)  # deg/h
+    assert row["Customary unit"] == "deg/h" and row["Lower"] < row["Value"] < row["Upper"]
     assert 5.0 < row["Tau (s)"] < 60.0  # between the crossings of the truth
+    # the IEEE plateau convention: the flicker line of the fit is 0.664 B
+    assert math.sqrt(FLICKER_AV_FACTOR) == pytest.approx(0.664, abs=5e-4)
 
 
 def test_the_joint_fit_recovers_an_exact_curve():
@@ -131,11 +141,11 @@ def test_every_input_kind_gives_the_same_terms(gyro, report):
     mapping = SimpleNamespace(columns={"gyro_x": data[:, 0]}, freq=FREQ)
     reports = [
         avar.noise_report(imu),
-        avar.noise_report(avar.avar(imu)),
+        avar.noise_report(avar.avar(imu, taus=2.0 ** np.arange(18) / FREQ)),
         avar.noise_report(frame, gyro_units="deg/s", freq=FREQ),
         avar.noise_report(recording, gyro_units="deg/s"),
         avar.noise_report(mapping, gyro_units="deg/s"),
-        avar.noise_report(avar.avar(gyro, freq=FREQ), gyro_units="deg/s"),
+        avar.noise_report(avar.avar(gyro, freq=FREQ, taus=2.0 ** np.arange(18) / FREQ), gyro_units="deg/s"),
     ]
     for rep in reports:
         channel = rep.channels[0]
@@ -155,7 +165,7 @@ def test_bad_arguments():
     with pytest.raises(ValueError, match="alpha"):
         avar.noise_report(x, alpha=1.5)
     with pytest.raises(ValueError, match="at least 3"):
-        avar.noise_report(x[:10])
+        avar.noise_report(x[:5])
     with pytest.raises(ValueError, match="gyro column"):
         avar.noise_report(pd.DataFrame({"a": x}), gyro=["b"], freq=1.0)
     with pytest.raises(KeyError, match="no term"):

@@ -34,10 +34,11 @@ def read_recording(args: argparse.Namespace):
                 topic=args.topic if is_bag else None)
     if isinstance(data, IMU):
         values = {name: data[name] for name in data.channels}
-        return SimpleNamespace(columns=values, freq=data.freq, source=str(args.file), topic=data.name)
+        return SimpleNamespace(columns=values, freq=data.freq, source=str(args.file), topic=data.name, bag=True)
     if data.time_column is None and args.freq is None:
         raise InputFileError(f"{args.file}: no time column to take the rate from; pass --freq (Hz)")
-    return SimpleNamespace(columns=dict(data.columns), freq=data.freq, source=str(args.file), topic=args.topic)
+    return SimpleNamespace(columns=dict(data.columns), freq=data.freq, source=str(args.file), topic=args.topic,
+                           bag=is_bag)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -45,10 +46,20 @@ def run(args: argparse.Namespace) -> int:
 
     inputs = [Path(args.file)]
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
-    kalibr = check_output_path("--kalibr", args.kalibr, inputs, args.force) if args.kalibr else None
-    if kalibr is not None and any(isinstance(p, Path) and p.resolve() == kalibr.resolve()
-                                  for p in (plan.csv, plan.figure)):
-        raise UsageError(f"--kalibr {args.kalibr!r} is also given for another output; give them different names")
+    extra = {}
+    for option, value in (("--kalibr", args.kalibr), ("--curves", args.curves)):
+        if value:
+            extra[option] = check_output_path(option, value, inputs, args.force)
+    taken = [p.resolve() for p in (plan.csv, plan.figure) if isinstance(p, Path)]
+    for option, path in extra.items():
+        if path.resolve() in taken:
+            raise UsageError(f"{option} {str(path)!r} is also given for another output; give them different names")
+        taken.append(path.resolve())
+    if Path(args.file).suffix.lower() in (".bag", ".db3", ".mcap") or Path(args.file).is_dir():
+        for option, value, si in (("--gyro-units", args.gyro_units, "rad/s"), ("--accel-units", args.accel_units, "m/s^2")):
+            if value is not None and value != si:
+                raise UsageError(f"{option} {value}: ROS bags hold sensor_msgs/Imu in SI units ({si}) by definition; "
+                                 f"drop {option}")
     progress = Progress()
     progress(f"reading {args.file}")
     recording = read_recording(args)
@@ -56,16 +67,22 @@ def run(args: argparse.Namespace) -> int:
     print(f"{args.file}: {len(recording.columns)} column(s) x {n} samples at {recording.freq:g} Hz", file=sys.stderr)
     progress("fitting the noise terms")
     report = noise_report(recording, gyro_units=args.gyro_units, accel_units=args.accel_units,
-                          gyro=args.gyro, accel=args.accel, alpha=args.alpha, name=Path(args.file).name)
+                          gyro=args.gyro, accel=args.accel, alpha=args.alpha, name=Path(args.file).name,
+                          from_bag=recording.bag, robust=args.robust)
+    contents = {}
+    if "--kalibr" in extra:
+        contents["--kalibr"] = report.kalibr_text(axis=args.kalibr_axis).encode("utf-8")
+    if "--curves" in extra:
+        contents["--curves"] = report.curves.to_csv(index=False).encode("utf-8")
     files = []
-    if kalibr is not None:
-        import yaml
-
-        text = yaml.safe_dump(report.kalibr(), sort_keys=False, default_flow_style=False)
-        write_atomically(kalibr, text.encode("utf-8"))
-        files.append(str(kalibr))
-    written = plan.write(csv=lambda: report.table.to_csv(index=False), figure=report.plot)
+    for option, data in contents.items():
+        write_atomically(extra[option], data)
+        files.append(str(extra[option]))
+    written = plan.write(csv=lambda: report.table.to_csv(index=False),
+                         figure=lambda: report.plot(customary_axis=args.customary_axis))
     progress("done")
+    for warning in report.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
     print_outputs(Written(tuple(files) + written.files, written.stdout_csv), str(report))
     return 0
 
@@ -87,7 +104,16 @@ def add_parser(commands) -> None:
     report.add_argument("--gaps", choices=["error", "ignore"], default="error",
                         help="time steps > 1.5 median steps: refuse (default) or treat the samples as contiguous")
     report.add_argument("--alpha", type=float, default=0.05, help="1 - confidence level of the intervals")
-    report.add_argument("--kalibr", metavar="YAML", help="write a Kalibr imu.yaml")
+    report.add_argument("--kalibr", metavar="YAML", help="write a Kalibr imu.yaml (a value for every key; "
+                        "a term the data do not resolve gives its 95%% upper bound, marked in a comment)")
+    report.add_argument("--kalibr-axis", choices=["max", "mean"], default="max",
+                        help="aggregate the axes of a sensor type for Kalibr: the largest (default) or the mean")
+    report.add_argument("--curves", metavar="CSV", help="write the curves: Channel, Tau (s), ADEV, Lower, Upper, "
+                        "Implied ADEV per level, to redraw any figure")
+    report.add_argument("--robust", action="store_true", help="robust Allan variance: a log with a few per cent "
+                        "of spikes gives the terms of the clean process")
+    report.add_argument("--customary-axis", action="store_true",
+                        help="the figure's right axis in deg/h (gyroscopes) or ug (accelerometers)")
     report.add_argument("--plot", metavar="PNG", help="write the report figure")
     report.add_argument("--output", metavar="CSV", help="write the table of terms")
     report.add_argument("--force", action="store_true", help="overwrite existing output files")

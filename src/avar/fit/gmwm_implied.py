@@ -27,6 +27,8 @@ __all__ = ["ImpliedAllanVariance"]
 
 #: Relative step of the forward differences in the unconstrained parameter.
 STEP = 1e-7
+#: Value of a shape parameter while the degrees of the others are found (inside its range).
+REFERENCE = {"atanh": 0.5, "half-logit": 0.1}
 
 
 class ImpliedAllanVariance:
@@ -50,7 +52,7 @@ class ImpliedAllanVariance:
         degrees: list[float | None] = []
         kinds = [t.kind for t in self.spec.transforms]
         for k, block in enumerate(self.blocks):
-            reference = np.array([0.5 if kinds[i] == "atanh" else 1.0 for i in range(block.start, block.stop)])
+            reference = np.array([REFERENCE.get(kinds[i], 1.0) for i in range(block.start, block.stop)])
             base = self._component(k, reference)
             for j in range(block.stop - block.start):
                 degree = None

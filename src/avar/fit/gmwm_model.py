@@ -10,7 +10,8 @@ A model to estimate is given without changing the process classes:
 Every :class:`~avar.models.Process` subclass with a ``name`` is accepted (the
 flicker noise included once its module is imported): its parameters are its
 dataclass fields, each mapped to the real line by a transform chosen by field
-name (:data:`TRANSFORMS`): ``phi`` -> atanh (|phi| < 1), ``omega`` -> log |omega|
+name (:data:`TRANSFORMS`): ``phi`` -> atanh (|phi| < 1), ``f`` -> logit(2 f)
+(0 < f < 1/2), ``omega`` -> log |omega|
 (the Allan variance sees omega^2 only, so its sign is not identifiable and
 |omega| is reported), every other field -> log (a variance or scale > 0).
 """
@@ -42,16 +43,22 @@ class Transform:
     def to_free(self, value: float) -> float:
         if self.kind == "atanh":
             return float(np.arctanh(np.clip(value, -1 + 1e-15, 1 - 1e-15)))
+        if self.kind == "half-logit":
+            share = float(np.clip(2.0 * value, 1e-15, 1 - 1e-15))
+            return math.log(share / (1.0 - share))
         return float(np.log(abs(value)))
 
     def from_free(self, free: float) -> float:
         if self.kind == "atanh":
             return math.tanh(min(max(float(free), -_TANH_CLIP), _TANH_CLIP))
+        if self.kind == "half-logit":
+            return 0.5 / (1.0 + math.exp(-min(max(float(free), -_LOG_CLIP), _LOG_CLIP)))
         return math.exp(min(max(float(free), -_LOG_CLIP), _LOG_CLIP))
 
 
 #: Transform of a parameter by field name; fields not listed are positive scales (log).
-TRANSFORMS = {"phi": Transform("atanh"), "omega": Transform("log")}
+#: ``f`` (a sinusoid's frequency in cycles per sample) lies in (0, 1/2): a logistic of 2 f.
+TRANSFORMS = {"phi": Transform("atanh"), "omega": Transform("log"), "f": Transform("half-logit")}
 POSITIVE = Transform("log")
 
 

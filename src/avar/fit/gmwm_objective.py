@@ -86,7 +86,7 @@ def _tangent(cls: type, values: dict[str, float], factors: np.ndarray, nu_hat: n
 def starting_points(spec: ModelSpec, factors: np.ndarray, nu_hat: np.ndarray) -> list[np.ndarray]:
     """Unconstrained starting vectors (see the module docstring)."""
     unset_phi = [k for k, (cls, start) in enumerate(zip(spec.classes, spec.starts))
-                 if start is None and "phi" in spec.fields[k]]
+                 if start is None and ("phi" in spec.fields[k] or "f" in spec.fields[k])]
     positions = TRIAL_POSITIONS if unset_phi else (0.5,)
     low, high = np.log(factors[0]), np.log(factors[-1])
     points = []
@@ -98,10 +98,14 @@ def starting_points(spec: ModelSpec, factors: np.ndarray, nu_hat: np.ndarray) ->
                 theta.extend(given.values())
                 continue
             values = {f.name: 1.0 for f in fields(cls)}
-            if "phi" in values:
+            if "phi" in values or "f" in values:
                 rank = unset_phi.index(k) if k in unset_phi else 0
                 spot = (rank + shift) / max(len(unset_phi), 1)
-                values["phi"] = float(np.exp(-1.0 / np.exp(low + spot * (high - low))))
+                scale = float(np.exp(low + spot * (high - low)))  # a trial correlation time or period (samples)
+                if "phi" in values:
+                    values["phi"] = float(np.exp(-1.0 / scale))
+                else:  # a sinusoid whose Allan variance peaks near m = 0.37 / f
+                    values["f"] = min(0.37 / scale, 0.45)
             theta.extend(_tangent(cls, values, factors, nu_hat).values())
         points.append(spec.free(np.array(theta)))
     return points

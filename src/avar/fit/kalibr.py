@@ -1,7 +1,7 @@
 """Kalibr ``imu.yaml`` from a :class:`~avar.fit.report_result.NoiseReport`.
 
 Kalibr (and ``allan_variance_ros``) describe an IMU by four continuous-time
-densities in SI units, each the mean over the axes of a sensor type:
+densities in SI units, each aggregated over the axes of a sensor type:
 
 =================================  ===========================================
 ``gyroscope_noise_density``        angle random walk N, rad/s/sqrt(Hz)
@@ -10,7 +10,10 @@ densities in SI units, each the mean over the axes of a sensor type:
 ``accelerometer_random_walk``      acceleration random walk K, m/s^3/sqrt(Hz)
 =================================  ===========================================
 
-plus ``rostopic`` (the bag topic the data came from) and ``update_rate`` (Hz).
+plus ``rostopic`` (the bag topic the data came from) and ``update_rate`` (the
+nominal rate, Hz). Each density is the largest over the axes (or their mean);
+a term the data do not resolve contributes its 95 % upper bound, and a
+comment above every density gives the axes' values and says so.
 N is the Allan deviation of the white noise at tau = 1 s and K that of the
 random walk at tau = 3 s (AD = K sqrt(tau / 3)), as Kalibr defines them.
 """
@@ -26,7 +29,8 @@ import numpy as np
 
 from avar.fit.noise_terms import ACCEL, GYRO
 
-__all__ = ["kalibr_fields", "write_kalibr", "DEFAULT_TOPIC"]
+__all__ = ["kalibr_fields", "kalibr_notes", "kalibr_text", "write_kalibr", "axis_values", "nominal_rate",
+           "DEFAULT_TOPIC"]
 
 #: Topic written when the data did not come from a bag (Kalibr's example).
 DEFAULT_TOPIC = "/imu0"
@@ -38,22 +42,41 @@ FIELDS = {
 }
 
 
-def _mean_over_axes(report: Any, kind: str, process: str) -> float | None:
+AGGREGATIONS = ("max", "mean")
+
+
+def axis_values(report: Any, kind: str, process: str) -> list[tuple[str, float, str]]:
+    """(channel, value in SI, status) of one term on every axis of a sensor type: the value, or the upper
+    bound of a term the data do not resolve (status ``bound``); axes where it is absent are left out."""
     table = report.terms
-    rows = table[(table["Sensor"] == kind) & (table["Process"] == process) & (table["Status"] == "present")]
-    return float(np.mean(rows["Value"].to_numpy(dtype=np.float64))) if len(rows) else None
+    rows = table[(table["Sensor"] == kind) & (table["Process"] == process)]
+    out = []
+    for _, row in rows.iterrows():
+        if row["Status"] == "present":
+            out.append((str(row["Channel"]), float(row["Value"]), "present"))
+        elif row["Status"] == "bound":
+            out.append((str(row["Channel"]), float(row["Upper"]), "bound"))
+    return out
+
+
+def nominal_rate(rate: float) -> float:
+    """The rate a datasheet states: 199.9999999957 -> 200.0 (kept when not within 1e-6 of a whole number)."""
+    whole = round(rate)
+    return float(whole) if whole > 0 and abs(rate - whole) <= 1e-6 * rate else float(rate)
 
 
 def kalibr_fields(report: Any, rostopic: str | None = None, update_rate: float | None = None,
-                  **densities: float) -> dict[str, Any]:
+                  axis: str = "max", **densities: float) -> dict[str, Any]:
     """The ``imu.yaml`` fields of a report, in Kalibr's order.
 
-    Each density is the mean over the axes of its sensor type on which the
-    term is present. ``rostopic`` defaults to the report's topic (the bag
-    topic), else ``"/imu0"``; ``update_rate`` to the report's rate. Any field
-    may be given explicitly (``gyroscope_random_walk=4e-5``), e.g. when the
-    record is too short to show a random walk: a density absent on every axis
-    is otherwise an error, never a silent 0 or NaN.
+    Each density aggregates the axes of its sensor type: ``axis="max"``
+    (default, conservative: the noisiest axis) or ``"mean"``. On an axis where
+    the data do not resolve a term (a random walk too small for the record),
+    its 95 % upper bound stands in; :func:`kalibr_notes` says so. A value is
+    written for every key of the sensor types present. ``rostopic`` defaults
+    to the report's topic (the bag topic), else ``"/imu0"``; ``update_rate`` to
+    the report's nominal rate. Any field may be given explicitly
+    (``gyroscope_random_walk=4e-5``).
 
     Examples
     --------
@@ -68,6 +91,8 @@ def kalibr_fields(report: Any, rostopic: str | None = None, update_rate: float |
     unknown = set(densities) - set(FIELDS.values())
     if unknown:
         raise TypeError(f"unknown Kalibr field(s) {sorted(unknown)}; give {list(FIELDS.values())}, rostopic, update_rate")
+    if axis not in AGGREGATIONS:
+        raise ValueError(f"axis must be 'max' (the noisiest axis) or 'mean', got {axis!r}")
     present = set(report.sensor_types) & {GYRO, ACCEL}
     if not present:
         raise ValueError("the report has no gyroscope or accelerometer channel; name them (gyro_units=..., "
@@ -80,18 +105,19 @@ def kalibr_fields(report: Any, rostopic: str | None = None, update_rate: float |
             key = FIELDS[kind, process]
             value = densities.get(key)
             if value is None:
-                value = _mean_over_axes(report, kind, process)
-            if value is None:
-                raise ValueError(
-                    f"{key}: the {kind.lower()} {'white noise' if process == 'WN' else 'random walk'} is absent "
-                    f"on every axis (the record is too short or too quiet to show it); give {key}=... explicitly"
-                )
+                values = [v for _, v, _ in axis_values(report, kind, process)]
+                if not values:
+                    raise ValueError(f"{key}: no {kind.lower()} axis has a value or a bound for it; "
+                                     f"give {key}=... explicitly")
+                value = max(values) if axis == "max" else float(np.mean(values))
+            if not np.isfinite(value) or value < 0:
+                raise ValueError(f"{key} must be a finite density >= 0, got {value!r}")
             fields[key] = float(value)
     fields = dict(sorted(fields.items(), key=lambda kv: list(FIELDS.values()).index(kv[0])))
     topic = rostopic if rostopic is not None else (report.topic or DEFAULT_TOPIC)
     if not isinstance(topic, str) or not topic:
         raise TypeError(f"rostopic must be a non-empty string, got {topic!r}")
-    rate = float(report.freq if update_rate is None else update_rate)
+    rate = nominal_rate(float(report.freq)) if update_rate is None else float(update_rate)
     if not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"update_rate must be a finite rate > 0 (Hz), got {update_rate!r}")
     fields["rostopic"] = topic
@@ -99,16 +125,48 @@ def kalibr_fields(report: Any, rostopic: str | None = None, update_rate: float |
     return fields
 
 
-def write_kalibr(report: Any, path: Any, force: bool = False, **overrides: Any) -> Path:
+def kalibr_notes(report: Any, axis: str = "max", **given: float) -> dict[str, str]:
+    """A yaml comment per density: the value of every axis, the aggregation, and which axes give only a bound."""
+    notes = {}
+    for (kind, process), key in FIELDS.items():
+        if kind not in report.sensor_types:
+            continue
+        if key in given:
+            notes[key] = "given explicitly"
+            continue
+        values = axis_values(report, kind, process)
+        parts = ", ".join(f"{name} {value:.4g}" + (" (95 % upper bound)" if status == "bound" else "")
+                          for name, value, status in values)
+        text = f"{'largest' if axis == 'max' else 'mean'} over the axes: {parts}"
+        bounded = [name for name, _, status in values if status == "bound"]
+        if bounded:
+            text += f"; not resolved on {', '.join(bounded)}: an upper bound, not a measurement"
+        notes[key] = text
+    return notes
+
+
+def kalibr_text(report: Any, axis: str = "max", **overrides: Any) -> str:
+    """The ``imu.yaml`` text: every field on its line, each density with its comment."""
+    import yaml
+
+    fields = kalibr_fields(report, axis=axis, **overrides)
+    notes = kalibr_notes(report, axis=axis, **{k: v for k, v in overrides.items() if k in FIELDS.values()})
+    lines = [f"# IMU noise model written by avar from {report.name}: Kalibr's continuous-time densities (SI)"]
+    for key, value in fields.items():
+        if key in notes:
+            lines.append(f"# {notes[key]}")
+        lines.append(yaml.safe_dump({key: value}, default_flow_style=False).strip())
+    return "\n".join(lines) + "\n"
+
+
+def write_kalibr(report: Any, path: Any, force: bool = False, axis: str = "max", **overrides: Any) -> Path:
     """Write :func:`kalibr_fields` to ``path`` as YAML (PyYAML); returns the path.
 
     The file is written to a temporary file in the same directory and renamed,
     so a failure never leaves a half-written ``imu.yaml``; an existing file is
     refused unless ``force=True``.
     """
-    import yaml
-
-    fields = kalibr_fields(report, **overrides)
+    text = kalibr_text(report, axis=axis, **overrides)
     target = Path(path)
     if target.exists() and not force:
         raise FileExistsError(f"{target} exists; pass force=True to overwrite it")
@@ -117,7 +175,7 @@ def write_kalibr(report: Any, path: Any, force: bool = False, **overrides: Any) 
     handle, temporary = tempfile.mkstemp(dir=target.parent if str(target.parent) else ".", suffix=".yaml.tmp")
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as out:
-            yaml.safe_dump(fields, out, sort_keys=False, default_flow_style=False)
+            out.write(text)
         os.replace(temporary, target)
     except BaseException:
         if os.path.exists(temporary):

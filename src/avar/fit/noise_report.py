@@ -1,32 +1,35 @@
 """The IMU noise report: :func:`noise_report`, from a log to ARW, bias instability and RRW.
 
-One call, no scales to pick: for every channel, the Allan variance (octave
-grid), the joint weighted fit of the IEEE 952 terms
-(:mod:`avar.fit.noise_fit`), the scales where each term dominates
-(:mod:`avar.fit.auto_scales`), chi-squared intervals, and the terms in SI and
-customary units (:mod:`avar.fit.noise_terms`). The result is a
-:class:`~avar.fit.report_result.NoiseReport`.
+One call, no scales to pick: for every channel, the maximal-overlap Allan
+variance on octaves from m = 1, its chi-squared band (Greenhall's EDF at the
+fitted noise type), the noise model chosen by the data among sums of QN,
+WN, FN, RW, DR, up to two Gauss-Markov and two sinusoid terms
+(:mod:`avar.fit.sensor_fit`), the terms in SI and customary units with
+intervals (:mod:`avar.fit.report_rows`), the Allan-deviation minimum, and
+checks of the fit, the units and the data (:mod:`avar.fit.report_checks`).
+The result is a :class:`~avar.fit.report_result.NoiseReport`.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from avar._validation import check_real
-from avar.fit.auto_scales import auto_scales, level_edf
-from avar.fit.noise_fit import TERMS, TermFit, fit_noise_terms
-from avar.fit.noise_terms import ACCEL, GYRO, TERM_NAMES, check_unit, customary, to_si, unit_of
+from avar._validation import as_series, check_real
+from avar.fit.gmwm import octave_factors
+from avar.fit.noise_terms import ACCEL, GYRO, check_unit
+from avar.fit.report_checks import FIT_SHARE, data_warnings, fit_check, unit_warnings
 from avar.fit.report_result import NoiseReport
+from avar.fit.report_rows import channel_rows, minimum_row
+from avar.fit.sensor_fit import SensorFit, fit_sensor_model, with_sampling_edf
 from avar.imu import IMU
 from avar.stability.allan import avar as allan_variance
 from avar.stability.results import AllanVariance, ImuAllanVariance
 
-__all__ = ["noise_report", "term_rows", "infer_sensor_type"]
+__all__ = ["noise_report", "infer_sensor_type", "fit_channel"]
 
 DEFAULT_UNITS = {GYRO: "rad/s", ACCEL: "m/s^2"}
 
@@ -67,15 +70,39 @@ def _selected(names: list[str], gyro: Any, accel: Any) -> list[tuple[str, str | 
     return chosen
 
 
-def _channels(x: Any, freq: Any, gyro: Any, accel: Any, taus: Any, type: str, single_kind: str | None) -> tuple:
-    """(channels [(name, sensor type, AllanVariance)], source, topic) from any accepted input."""
+def _grid(taus: Any, n: int, rate: float) -> Any:
+    return octave_factors(n) / rate if isinstance(taus, str) and taus == "octave" else taus
+
+
+def _estimator(robust: bool, type: str) -> Any:
+    """The Allan variance of one series: the plain estimator, or the robust one (``type="mo"`` only)."""
+    if not robust:
+        return lambda values, freq, taus: allan_variance(values, type=type, freq=freq, taus=taus)
+    if type != "mo":
+        raise ValueError(f"robust=True estimates the maximal-overlap Allan variance; type must be 'mo', got {type!r}")
+    from avar.stability.robust import robust_allan_variance
+
+    return lambda values, freq, taus: robust_allan_variance(values, freq=1.0 if freq is None else freq, taus=taus)
+
+
+def _channels(x: Any, freq: Any, gyro: Any, accel: Any, taus: Any, type: str, single_kind: str | None,
+              robust: bool = False) -> tuple:
+    """([(name, sensor type, AllanVariance, values or None)], source, topic) from any accepted input."""
+    estimate = _estimator(robust, type)
     if isinstance(x, IMU):
-        x = allan_variance(x, type=type, taus=taus)
+        rows = []
+        for name, kind in zip(x.channels, x.sensor_types):
+            values = np.asarray(x[name], dtype=np.float64)
+            av = estimate(values, x.freq, _grid(taus, x.n, x.freq))
+            rows.append((name, kind, av, values))
+        return rows, getattr(x, "name", None), None
+    if robust and isinstance(x, (ImuAllanVariance, AllanVariance)):
+        raise ValueError("robust=True needs the samples: give the series, table, IMU or recording, not an Allan variance")
     if isinstance(x, ImuAllanVariance):
-        rows = [(name, kind, av) for (name, av), kind in zip(x.channels.items(), x.sensor_types)]
+        rows = [(name, kind, av, None) for (name, av), kind in zip(x.channels.items(), x.sensor_types)]
         return rows, x.sensor, None
     if isinstance(x, AllanVariance):
-        return [(x.name or "x", single_kind, x)], None, None
+        return [(x.name or "x", single_kind, x, None)], None, None
     if isinstance(x, pd.DataFrame) or (hasattr(x, "columns") and hasattr(x, "freq")):
         if isinstance(x, pd.DataFrame):
             values = {str(c): x[c] for c in x.columns}
@@ -86,59 +113,56 @@ def _channels(x: Any, freq: Any, gyro: Any, accel: Any, taus: Any, type: str, si
             source, topic = getattr(x, "source", None), getattr(x, "topic", None)
         rows = []
         for name, kind in _selected(list(values), gyro, accel):
-            rows.append((name, kind, allan_variance(values[name], type=type, freq=rate, taus=taus)))
+            series = np.asarray(values[name], dtype=np.float64)
+            grid = _grid(taus, series.size, 1.0 if rate is None else float(rate))
+            rows.append((name, kind, estimate(values[name], rate, grid), series))
         if not rows:
             raise ValueError("x has no data column")
         return rows, None if source is None else str(source), None if topic is None else str(topic)
     name = getattr(x, "name", None) if isinstance(x, pd.Series) else None
-    av = allan_variance(x, type=type, freq=freq, taus=taus)
-    return [(str(name) if name is not None else "x", single_kind, av)], None, None
+    series, rate = as_series(x, freq)
+    series = np.asarray(series, dtype=np.float64)
+    av = estimate(x, rate if freq is None and not isinstance(x, pd.Series) else freq, _grid(taus, series.size, rate))
+    return [(str(name) if name is not None else "x", single_kind, av, series)], None, None
 
 
-def _interval(squared: float, edf: float, alpha: float) -> tuple[float, float]:
-    """Chi-squared interval of a coefficient whose square has ``edf`` degrees of freedom."""
-    if not math.isfinite(edf):
-        return math.sqrt(squared), math.sqrt(squared)
-    from scipy.stats import chi2
+def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray, np.ndarray]:
+    """The selected model of one Allan variance and its 1 - alpha band (lower, upper deviation).
 
-    low = squared * edf / chi2.ppf(1.0 - alpha / 2.0, edf)
-    high = squared * edf / chi2.ppf(alpha / 2.0, edf)
-    return math.sqrt(low), math.sqrt(high)
+    The fit weighs the levels by their degrees of freedom (N - 2m + 1) / m;
+    the band and the parameters' covariance then use Greenhall's EDF of the
+    overlapping Allan variance at the noise type of the fitted model's local
+    slope (alpha = -1 - d log AV / d log tau, rounded into -2..2). When the
+    selected model fits fewer than 90 % of the levels, the selection is
+    extended by the terms the data demand (``check`` of
+    :func:`~avar.fit.sensor_fit.fit_sensor_model`).
+    """
+    factors = np.asarray(av.averaging_factors, dtype=np.int64)
+    counts = np.maximum(av.n - 2 * factors + 1, 1)
+    nu_hat, adev = np.asarray(av.allan, dtype=np.float64), np.asarray(av.adev, dtype=np.float64)
+    fit = fit_sensor_model(factors, nu_hat, counts / factors)
+    lower, upper, edf, noise = _band(av, fit.implied(factors), alpha)
+
+    def share(implied: np.ndarray) -> float:
+        return float(np.mean(fit_check("", av.levels, adev, lower, upper, np.sqrt(implied))[0]))
+
+    if share(fit.implied(factors)) < FIT_SHARE:
+        fit = fit_sensor_model(factors, nu_hat, counts / factors, check=share)
+        lower, upper, edf, noise = _band(av, fit.implied(factors), alpha)
+    return with_sampling_edf(fit, edf, noise), lower, upper
 
 
-def term_rows(channel: str, kind: str | None, unit: str | None, av: AllanVariance, fit: TermFit,
-              scales: Mapping[str, np.ndarray], alpha: float) -> list[dict[str, Any]]:
-    """The table rows of one channel: one per IEEE term, SI and customary values, intervals, scales."""
-    from avar.fit.slopes import format_scales
+def _band(av: AllanVariance, implied: np.ndarray, alpha: float) -> tuple[np.ndarray, ...]:
+    """Lower and upper 1 - alpha chi-squared bounds of the deviation, Greenhall's EDF at the model's noise
+    types, and those types (power-law alpha: AV slope mu gives -1 - mu, and 2 (white PM) below -1.5)."""
+    from avar.stability.edf import chi2_bounds, greenhall_edf
 
-    model = np.sqrt(fit.model_av(av.levels))
-    rows = []
-    for term in TERMS:
-        present = fit.present[term]
-        row: dict[str, Any] = {
-            "Channel": channel, "Sensor": kind or "", "Term": TERM_NAMES[kind][term], "Process": term,
-            "Status": "present" if present else "absent",
-            "Value": pd.NA, "Lower": pd.NA, "Upper": pd.NA, "Unit": unit_of(term, kind, unit),
-            "Customary": pd.NA, "Customary lower": pd.NA, "Customary upper": pd.NA, "Customary unit": "",
-            "Tau (s)": pd.NA, "Scales": "",
-        }
-        if kind in (GYRO, ACCEL):
-            row["Customary unit"] = customary(term, 1.0, kind)[1]
-        if present:
-            value = fit.coefficient(term)
-            lower, upper = _interval(fit.squared[term], fit.edf(term), alpha)
-            si = [to_si(v, kind, unit) for v in (value, lower, upper)]
-            row.update({"Value": si[0], "Lower": si[1], "Upper": si[2]})
-            if kind in (GYRO, ACCEL):
-                row.update({"Customary": customary(term, si[0], kind)[0],
-                            "Customary lower": customary(term, si[1], kind)[0],
-                            "Customary upper": customary(term, si[2], kind)[0]})
-            used = scales.get(term, np.zeros(0, dtype=np.int64))
-            row["Scales"] = format_scales(np.asarray(used)) if len(used) else "-"
-            if term == "FN":
-                row["Tau (s)"] = float(av.levels[int(np.argmin(model))])
-        rows.append(row)
-    return rows
+    factors = np.asarray(av.averaging_factors, dtype=np.int64)
+    slope = np.gradient(np.log(implied), np.log(factors)) if factors.size > 1 else np.zeros(1)
+    noise = np.where(slope < -1.5, 2, np.clip(np.rint(-1.0 - slope), -2, 1)).astype(np.int64)
+    edf = greenhall_edf(noise, 2, factors, av.n + 1, overlapping=True, modified=False)
+    lower, upper = chi2_bounds(np.sqrt(av.allan), edf, 1.0 - alpha)
+    return np.asarray(lower), np.asarray(upper), np.asarray(edf), noise
 
 
 def noise_report(
@@ -153,22 +177,35 @@ def noise_report(
     type: str = "mo",
     taus: Any = "octave",
     name: str | None = None,
+    from_bag: bool = False,
+    robust: bool = False,
 ) -> NoiseReport:
-    """IEEE 952 noise terms of every channel, with no scales to choose.
+    """Noise terms of every channel of a real sensor's log, with no scales to choose.
 
-    Per channel: quantization Q, angle / velocity random walk N, bias
-    instability B (with the tau where it is read), rate / acceleration random
-    walk K and ramp R, from the joint weighted fit of::
+    Per channel: the maximal-overlap Allan variance at m = 1, 2, 4, ...; the
+    noise model chosen by the data among sums of quantization QN, white noise
+    WN, flicker FN, random walk RW, ramp DR, up to two first-order
+    Gauss-Markov and two sinusoid terms, fitted jointly at every level by
+    maximum likelihood and selected by a penalized deviance
+    (:func:`avar.fit.sensor_fit.fit_sensor_model`); then, in SI and customary
+    units with 1 - alpha intervals:
 
-        AV(tau) = 3 Q^2 / tau^2 + N^2 / tau + (2 ln 2 / pi) B^2 + K^2 tau / 3 + R^2 tau^2 / 2
+    * quantization Q, angle / velocity random walk N, bias instability B
+      (IEEE 952: the flicker plateau of the Allan deviation is 0.664 B),
+      rate / acceleration random walk K, ramp R, each ``present``,
+      ``bound`` (N, B, K left out by the selection: their upper bound) or
+      ``absent``::
 
-    to the Allan variance at every level (:func:`avar.fit.noise_fit.fit_noise_terms`;
-    terms not significantly above zero are *absent*, never NaN), with
-    chi-squared intervals (the squared coefficient with edf = 2 s^2 / Var s),
-    in SI units (rad/s/sqrt(Hz), rad/s, rad/s^2/sqrt(Hz); m/s^2/sqrt(Hz), m/s^2,
-    m/s^3/sqrt(Hz)) and customary ones (deg/sqrt(h), deg/h, deg/h/sqrt(h);
-    m/s/sqrt(h), ug, m/s^2/sqrt(h)). The scales where each term dominates come
-    from :func:`avar.fit.auto_scales.auto_scales`.
+          AV(tau) = 3 Q^2 / tau^2 + N^2 / tau + (2 ln 2 / pi) B^2 + K^2 tau / 3 + R^2 tau^2 / 2 + ...
+
+    * Gauss-Markov sigma and correlation time, sinusoid amplitude and frequency;
+    * the **Allan-deviation minimum** and its tau (the "in-run bias stability"
+      of datasheets), also in deg/h or ug.
+
+    The implied deviation is checked against the empirical band at every
+    level; a channel where it fits fewer than 90 % of the levels, wrong-looking
+    units, clipped, stuck, spiky, moving or short data each add a warning
+    (:attr:`NoiseReport.warnings`).
 
     Parameters
     ----------
@@ -189,20 +226,26 @@ def noise_report(
         ``ax``, ``linear_acceleration.*``; other columns are reported without a
         sensor type, in data units).
     alpha : float
-        1 - confidence level of the intervals, in (0, 1).
+        1 - confidence level of the intervals and of the band, in (0, 1).
     type, taus
-        Estimator and tau grid, as for :func:`avar.avar`.
+        Estimator and tau grid, as for :func:`avar.avar` (``"octave"``: m = 1, 2, 4, ...).
     name : str, optional
         Label of the report (default: the IMU or recording name).
+    from_bag : bool
+        The data came from a ROS bag (SI units by definition): a non-SI unit is warned about.
+    robust : bool
+        Estimate the Allan variance robustly (:func:`avar.stability.robust.robust_allan_variance`):
+        a log with a few per cent of spikes gives the terms of the clean process.
 
     Returns
     -------
     NoiseReport
-        ``.table`` (DataFrame), ``plot()``, ``to_kalibr(path)``.
+        ``.table`` (DataFrame), ``.curves``, ``.warnings``, ``plot()``, ``to_kalibr(path)``.
 
     References
     ----------
-    IEEE Std 952-1997, Annex C; IEEE Std 1554-2005.
+    IEEE Std 952-1997, Annex C; IEEE Std 1554-2005. C. A. Greenhall, W. J. Riley,
+    "Uncertainty of stability variances based on finite differences", 2003.
 
     Examples
     --------
@@ -211,11 +254,11 @@ def noise_report(
     >>> model = avar.WN.from_continuous(2e-3, f) + avar.FN(b2=1e-6) + avar.RW.from_continuous(1.5e-4, f)
     >>> x = model.simulate(360_000, seed=3)  # one hour of a gyro in deg/s
     >>> report = avar.noise_report(x, gyro_units="deg/s", freq=f)
-    >>> [round(report.value("x", p, customary=True), 2) for p in ("WN", "FN", "RW")]  # truth 0.12, 3.6, 32.4
-    [0.12, 3.63, 32.53]
-    >>> table = report.table.set_index("Process")
-    >>> table.loc["QN", "Status"]
-    'absent'
+    >>> truth = {"WN": 0.12, "FN": 3.6, "RW": 32.4}   # deg/sqrt(h), deg/h, deg/h/sqrt(h)
+    >>> [round(report.value("x", p, customary=True) / truth[p], 1) for p in truth]   # estimate / truth
+    [1.0, 1.0, 1.0]
+    >>> report.table.set_index("Process").loc[["QN", "DR"], "Status"].tolist()
+    ['absent', 'absent']
     """
     if gyro_units is not None and accel_units is not None and not _multi_channel(x):
         raise ValueError("a single series is one sensor: give gyro_units or accel_units, not both")
@@ -228,29 +271,52 @@ def noise_report(
     if name is not None and not isinstance(name, str):
         raise TypeError(f"name must be a string, got {name!r}")
     own_units = dict(getattr(x, "units", None) or {}) if isinstance(x, (IMU, ImuAllanVariance)) else {}
-    channels, source, topic = _channels(x, freq, gyro, accel, taus, type, single_kind)
-    rows, fits, scales, avs, kinds, data_units = [], {}, {}, {}, [], []
-    for channel, kind, av in channels:
+    if not isinstance(robust, (bool, np.bool_)):
+        raise TypeError(f"robust must be True or False, got {robust!r}")
+    channels, source, topic = _channels(x, freq, gyro, accel, taus, type, single_kind, bool(robust))
+    rows, fits, avs, kinds, data_units, warnings, curves = [], {}, {}, [], [], [], []
+    for channel, kind, av, values in channels:
         if len(av) < 3:
             raise ValueError(f"channel {channel!r} has an Allan variance of {len(av)} level(s); "
                              "the noise report needs at least 3 (a longer record)")
+        if not np.all(np.isfinite(av.allan) & (av.allan > 0)):
+            raise ValueError(f"channel {channel!r}: the Allan variance is zero or not finite at some level "
+                             "(a constant or exactly linear channel has no noise to fit)")
         unit = None
         if kind is not None:
             given = units[kind] or own_units.get(kind)
             unit = check_unit(given, kind, "gyro_units" if kind == GYRO else "accel_units") if given \
                 else DEFAULT_UNITS[kind]
-        fit = fit_noise_terms(av.levels, av.allan, level_edf(av))
-        selection = auto_scales(av, fit=fit)
-        fits[channel], scales[channel], avs[channel] = fit, selection, av
+        fit, lower, upper = fit_channel(av, alpha)
+        implied = np.sqrt(fit.implied(av.averaging_factors))
+        fits_level, departure = fit_check(channel, av.levels, av.adev, lower, upper, implied)
+        fits[channel], avs[channel] = fit, av
         kinds.append(kind)
         data_units.append(unit)
-        rows += term_rows(channel, kind, unit, av, fit, selection.scales, alpha)
+        rows += channel_rows(channel, kind, unit, fit, av.freq, alpha)
+        rows.append(minimum_row(channel, kind, unit, av.levels, av.adev, lower, upper))
+        notes = [departure] if departure else []
+        if values is not None:
+            notes += data_warnings(channel, kind, values, av.freq, len(av))
+        if kind is not None:
+            white = [c.scale for c in fit.components if c.kind == "WN"]
+            density = float(np.sqrt(white[0] / av.freq)) if white else None
+            notes += unit_warnings(channel, kind, unit, values if values is not None else np.zeros(0),
+                                   density, from_bag)
+        for note in notes:
+            rows.append({"Channel": channel, "Sensor": kind or "", "Term": "Warning", "Process": "WARNING",
+                         "Status": "warning", "Note": note})
+        warnings += notes
+        curves.append(pd.DataFrame({"Channel": channel, "Tau (s)": av.levels, "ADEV": av.adev, "Lower": lower,
+                                    "Upper": upper, "Implied ADEV": implied, "Fits": fits_level,
+                                    "Unit": unit or ""}))
     first = channels[0][2]
     return NoiseReport(
         name=name or source or (channels[0][0] if len(channels) == 1 else "IMU"),
         source=source, topic=topic, freq=first.freq, n=first.n,
-        channels=tuple(c for c, _, _ in channels), sensor_types=tuple(kinds), units=tuple(data_units),
-        avs=avs, fits=fits, scales=scales, terms=pd.DataFrame(rows), alpha=alpha,
+        channels=tuple(c[0] for c in channels), sensor_types=tuple(kinds), units=tuple(data_units),
+        avs=avs, fits=fits, terms=pd.DataFrame(rows), alpha=alpha, curves=pd.concat(curves, ignore_index=True),
+        warnings=tuple(warnings),
     )
 
 

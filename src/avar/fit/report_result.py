@@ -1,7 +1,8 @@
 """The result of :func:`avar.noise_report`: :class:`NoiseReport`.
 
-Holds numbers only: the Allan variance, the joint term fit and the automatic
-scales of every channel, and the table of terms. ``plot()`` draws the report
+Holds numbers only: the Allan variance and the selected model of every
+channel, the table of terms, the curves (empirical deviation, band, implied
+deviation) and the warnings. ``plot()`` draws the report
 figure (:mod:`avar.plotting.report`), ``to_kalibr(path)`` writes a Kalibr
 ``imu.yaml`` (:mod:`avar.fit.kalibr`).
 """
@@ -22,12 +23,12 @@ __all__ = ["NoiseReport"]
 
 #: Columns of :attr:`NoiseReport.table`.
 TABLE_COLUMNS = ["Channel", "Sensor", "Term", "Process", "Status", "Value", "Lower", "Upper", "Unit",
-                 "Customary", "Customary lower", "Customary upper", "Customary unit", "Tau (s)", "Scales"]
+                 "Customary", "Customary lower", "Customary upper", "Customary unit", "Tau (s)", "Note"]
 NUMERIC_COLUMNS = ["Value", "Lower", "Upper", "Customary", "Customary lower", "Customary upper", "Tau (s)"]
 
 
 def _number(value: Any) -> str:
-    return "absent" if value is pd.NA or value is None else f"{value:.4g}"
+    return "none" if value is pd.NA or value is None else f"{value:.4g}"
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,12 +49,17 @@ class NoiseReport:
         Channel names, ``"Gyroscope"``/``"Accelerometer"``/None, data units.
     avs : Mapping[str, AllanVariance]
         The Allan variance of every channel.
-    fits : Mapping[str, TermFit]
-        The joint term fit of every channel (squared coefficients in data units).
-    scales : Mapping[str, AutoScales]
-        The scales where each term dominates, per channel.
+    fits : Mapping[str, SensorFit]
+        The selected model of every channel (per-sample variances in data units).
+    terms : DataFrame
+        The table (see :attr:`table`).
     alpha : float
         1 - confidence level of the intervals.
+    curves : DataFrame
+        Per channel and level: ``Channel, Tau (s), ADEV, Lower, Upper, Implied ADEV, Fits, Unit``
+        (deviations in data units; ``Fits``: the implied deviation is inside the band or within 10 %).
+    warnings : tuple of str
+        Every warning of the report (fit, units, data), one line each.
     """
 
     name: str
@@ -66,13 +72,16 @@ class NoiseReport:
     units: tuple[str | None, ...]
     avs: Mapping[str, Any]
     fits: Mapping[str, Any]
-    scales: Mapping[str, Any]
     terms: pd.DataFrame
     alpha: float
+    curves: pd.DataFrame
+    warnings: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         set_field = object.__setattr__
-        for field in ("avs", "fits", "scales"):
+        set_field(self, "warnings", tuple(self.warnings))
+        set_field(self, "curves", self.curves.copy())
+        for field in ("avs", "fits"):
             set_field(self, field, frozen_mapping(getattr(self, field)))
         terms = self.terms.reindex(columns=TABLE_COLUMNS).copy()
         for column in NUMERIC_COLUMNS:
@@ -81,9 +90,10 @@ class NoiseReport:
 
     @property
     def table(self) -> pd.DataFrame:
-        """One row per channel and term: status, value, chi-squared interval, unit (SI when the
-        sensor type is known), the same in customary units, the tau where the bias instability
-        is read and the scales where the term dominates. Absent terms hold <NA>, never NaN."""
+        """One row per channel and term: status (``present``, ``bound``, ``absent``, ``measured`` for
+        the Allan-deviation minimum, ``warning``), value, interval (a bound: 0 to its upper bound),
+        unit (SI when the sensor type is known), the same in customary units, a tau (the minimum's,
+        a Gauss-Markov correlation time, a sinusoid's period) and a note. Missing values are <NA>."""
         return self.terms.copy()
 
     def summary(self) -> pd.DataFrame:
@@ -91,7 +101,10 @@ class NoiseReport:
         return self.table
 
     def value(self, channel: str, process: str, customary: bool = False) -> float | None:
-        """One term of one channel (SI, or customary units), None when absent.
+        """One term of one channel (SI, or customary units), None when absent or only bounded.
+
+        ``process`` is a row's ``Process``: QN, WN, FN, RW, DR, AR1_1, AR1_1.T, SIN_1, SIN_1.f, or MIN
+        (the Allan-deviation minimum).
 
         >>> import avar
         >>> x = avar.WN(sigma2=1e-4).simulate(20_000, seed=1)
@@ -100,8 +113,9 @@ class NoiseReport:
         """
         rows = self.terms[(self.terms["Channel"] == channel) & (self.terms["Process"] == process)]
         if rows.empty:
+            known = sorted(set(self.terms.loc[self.terms["Channel"] == channel, "Process"]) - {"WARNING"})
             raise KeyError(f"no term {process!r} of channel {channel!r}; channels {list(self.channels)}, "
-                           "processes QN, WN, FN, RW, DR")
+                           f"processes {known}")
         value = rows.iloc[0]["Customary" if customary else "Value"]
         return None if value is pd.NA else float(value)
 
@@ -113,11 +127,11 @@ class NoiseReport:
         the sum of the terms' deviations (DESIGN defect 6), on request only.
         """
         fit, av = self.fits[channel], self.avs[channel]
-        parts = fit.component_av(av.levels)
+        parts = [c.av(av.averaging_factors) for c in fit.components]
         if implied == "sum":
-            return sum(parts.values(), np.zeros(len(av)))
+            return sum(parts, np.zeros(len(av)))
         if implied == "r":
-            return sum((np.sqrt(p) for p in parts.values()), np.zeros(len(av))) ** 2
+            return sum((np.sqrt(p) for p in parts), np.zeros(len(av))) ** 2
         raise ValueError(f"implied must be 'sum' (sum of the processes' variances) or 'r' (R's curve), got {implied!r}")
 
     def kalibr(self, **overrides: Any) -> dict[str, Any]:
@@ -125,6 +139,12 @@ class NoiseReport:
         from avar.fit.kalibr import kalibr_fields
 
         return kalibr_fields(self, **overrides)
+
+    def kalibr_text(self, axis: str = "max", **overrides: Any) -> str:
+        """The Kalibr ``imu.yaml`` text with its comments; see :func:`avar.fit.kalibr.kalibr_text`."""
+        from avar.fit.kalibr import kalibr_text
+
+        return kalibr_text(self, axis=axis, **overrides)
 
     def to_kalibr(self, path: Any, force: bool = False, **overrides: Any) -> Any:
         """Write a Kalibr ``imu.yaml``; see :func:`avar.fit.kalibr.write_kalibr`."""
@@ -149,16 +169,25 @@ class NoiseReport:
             lines.append(f"\n{channel}" + (f" ({kind.lower()})" if kind else ""))
             rows = self.terms[self.terms["Channel"] == channel]
             for _, row in rows.iterrows():
-                if row["Status"] == "absent":
-                    lines.append(f"  {row['Term']:<26} absent")
+                if row["Status"] == "warning":
+                    lines.append(f"  warning: {row['Note']}")
                     continue
-                text = (f"  {row['Term']:<26} {_number(row['Value'])} {row['Unit']} "
+                if row["Status"] == "absent":
+                    lines.append(f"  {row['Term']:<34} absent")
+                    continue
+                if row["Status"] == "bound":
+                    text = f"  {row['Term']:<34} < {_number(row['Upper'])} {row['Unit']} (95 % bound, not resolved)"
+                    if row["Customary unit"]:
+                        text += f" = < {_number(row['Customary upper'])} {row['Customary unit']}"
+                    lines.append(text)
+                    continue
+                text = (f"  {row['Term']:<34} {_number(row['Value'])} {row['Unit']} "
                         f"[{_number(row['Lower'])}, {_number(row['Upper'])}]")
                 if row["Customary unit"]:
                     text += f" = {_number(row['Customary'])} {row['Customary unit']}"
-                if row["Tau (s)"] is not pd.NA:
+                if row["Tau (s)"] is not pd.NA and row["Process"] == "MIN":
                     text += f" at tau = {row['Tau (s)']:.4g} s"
-                lines.append(text + f"  (scales {row['Scales']})")
+                lines.append(text)
         return "\n".join(lines)
 
     def __repr__(self) -> str:

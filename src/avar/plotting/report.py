@@ -9,8 +9,10 @@ against tau in seconds, with the data unit on the y axis:
 * one dashed line per term present, labelled with its value and unit
   (customary units for gyroscopes and accelerometers: deg/sqrt(h), deg/h,
   deg/h/sqrt(h); m/s/sqrt(h), ug, m/s^2/sqrt(h));
-* the bias-instability point (a star at the tau where it is read, on the
-  flicker plateau 0.664 B);
+* Gauss-Markov and sinusoid terms, labelled by correlation time and frequency;
+* the Allan-deviation minimum (a star, labelled in deg/h or ug): the
+  datasheets' in-run bias stability; the B line says its convention;
+* a panel whose fit fails the check says so in its title;
 * the implied curve: the square root of the **sum of the terms' Allan
   variances** (independent processes: variances add); R ``avar``'s curve, the
   square of the sum of deviations (DESIGN defect 6), only with ``implied="r"``.
@@ -39,7 +41,7 @@ from avar.plotting.base import (
 
 __all__ = ["plot_report", "term_label"]
 
-COLOURS = {**PROCESS_COLOURS, "FN": "#1F77B4"}
+COLOURS = {**PROCESS_COLOURS, "FN": "#1F77B4", "AR1": "#8C564B", "SIN": "#E377C2"}
 SYMBOLS = {"QN": "Q", "WN": "N", "FN": "B", "RW": "K", "DR": "R"}
 BI_MARKER = "*"
 PANEL_SIZE = (4.6, 3.6)
@@ -70,6 +72,7 @@ def plot_report(
     ci: bool = True,
     legend: bool = True,
     fig: Figure | None = None,
+    customary_axis: bool = False,
 ) -> Figure:
     """Allan deviation of every channel of a noise report with its fitted terms.
 
@@ -89,6 +92,8 @@ def plot_report(
         Legend in every panel.
     fig : matplotlib.figure.Figure, optional
         Figure to draw on (default: a new headless one).
+    customary_axis : bool
+        Add a right axis in deg/h (gyroscopes) or ug (accelerometers) to deviation panels.
 
     Returns
     -------
@@ -100,13 +105,14 @@ def plot_report(
     >>> x = (avar.WN(sigma2=1e-6) + avar.FN(b2=1e-9)).simulate(50_000, seed=1)
     >>> fig = avar.noise_report(x, gyro_units="rad/s", freq=100.0).plot()
     >>> [line.get_label() for line in fig.axes[0].lines][1:]
-    ['N = 0.341 deg/sqrt(h)', 'B = 6.31 deg/h', 'B read at tau = 164 s', 'Implied AD (sum of variances)']
+    ['N = 0.341 deg/sqrt(h)', 'B = 6.6 deg/h (IEEE 952: AD = 0.664 B)', 'AD minimum 2.51 deg/h at 164 s', 'Implied AD (sum of variances)']
     """
     from avar.fit.report_result import NoiseReport
 
     if not isinstance(report, NoiseReport):
         raise TypeError(f"report must be a NoiseReport (from avar.noise_report), got {type(report).__name__}")
     deviation, ci, legend = check_flag(deviation, "deviation"), check_flag(ci, "ci"), check_flag(legend, "legend")
+    customary_axis = check_flag(customary_axis, "customary_axis")
     if implied not in ("sum", "r"):
         raise ValueError(f"implied must be 'sum' (sum of the processes' variances) or 'r' (R's curve), got {implied!r}")
     wanted = list(report.channels) if channels is None else [channels] if isinstance(channels, str) else list(channels)
@@ -129,8 +135,34 @@ def plot_report(
                 ax.set_visible(False)
                 continue
             _panel(ax, report, row[c], deviation, power, implied, ci, legend)
+            if customary_axis and deviation:
+                _customary_axis(ax, report, row[c])
     fig.suptitle(f"Noise report: {report.name}" + (f" ({report.topic})" if report.topic else ""))
     return fig
+
+
+def _customary_axis(ax: Any, report: Any, channel: str) -> None:
+    """A right axis in deg/h or ug for a gyroscope or accelerometer in known units."""
+    from avar.fit.noise_terms import ACCEL, GYRO, to_si
+
+    index = report.channels.index(channel)
+    kind, unit = report.sensor_types[index], report.units[index]
+    if kind not in (GYRO, ACCEL) or unit is None:
+        return
+    factor = to_si(1.0, kind, unit) * (3600.0 * 180.0 / math.pi if kind == GYRO else 1.0 / 9.80665e-6)
+    axis = ax.secondary_yaxis("right", functions=(lambda v: v * factor, lambda v: v / factor))
+    axis.set_ylabel("deg/h" if kind == GYRO else "ug")
+
+
+def _component_label(report: Any, channel: str, kind: str, number: int) -> str:
+    if kind in SYMBOLS:
+        text = term_label(report, channel, kind)
+        return text + " (IEEE 952: AD = 0.664 B)" if kind == "FN" else text
+    rows = report.terms[(report.terms["Channel"] == channel) & (report.terms["Process"] == f"{kind}_{number}")]
+    row = rows.iloc[0]
+    if kind == "AR1":
+        return f"Gauss-Markov {number}: T = {float(row['Tau (s)']):.3g} s"
+    return f"Sinusoid {number}: {1.0 / float(row['Tau (s)']):.3g} Hz"
 
 
 def _panel(ax: Any, report: Any, channel: str, deviation: bool, power: int, implied: str, ci: bool,
@@ -142,24 +174,29 @@ def _panel(ax: Any, report: Any, channel: str, deviation: bool, power: int, impl
     drawn = draw_empirical(ax, av, deviation=deviation, colour=AD_COLOUR, band_colour=CI_COLOUR, ci=ci,
                            marker="o", markersize=3.5, label="Empirical AD" if deviation else "Empirical AV",
                            band_label=None)
-    components = fit.component_av(av.levels)
-    for process, variance in components.items():
-        ax.plot(av.levels, np.sqrt(variance) ** power, color=COLOURS.get(process, "0.3"), linestyle="--",
-                linewidth=1.2, label=term_label(report, channel, process), zorder=2)
+    counts: dict[str, int] = {}
+    for component in fit.components:
+        counts[component.kind] = counts.get(component.kind, 0) + 1
+        variance = component.av(av.averaging_factors)
+        ax.plot(av.levels, np.sqrt(variance) ** power, color=COLOURS.get(component.kind, "0.3"), linestyle="--",
+                linewidth=1.2, label=_component_label(report, channel, component.kind, counts[component.kind]),
+                zorder=2)
     extra = []
-    if fit.present["FN"]:
-        row = report.terms[(report.terms["Channel"] == channel) & (report.terms["Process"] == "FN")].iloc[0]
-        tau_b = float(row["Tau (s)"])
-        level = math.sqrt(components["FN"][0]) ** power
-        ax.plot([tau_b], [level], linestyle="none", marker=BI_MARKER, markersize=13, color=COLOURS["FN"],
-                markeredgecolor="black", label=f"B read at tau = {tau_b:.3g} s", zorder=6)
+    rows = report.terms[(report.terms["Channel"] == channel) & (report.terms["Process"] == "MIN")]
+    if len(rows):
+        row = rows.iloc[0]
+        tau_min = float(row["Tau (s)"])
+        level = float(np.min(av.adev)) ** power
+        text = f"{float(row['Customary']):.3g} {row['Customary unit']}" if row["Customary unit"] else f"{level:.3g}"
+        ax.plot([tau_min], [level], linestyle="none", marker=BI_MARKER, markersize=13, color=COLOURS["FN"],
+                markeredgecolor="black", label=f"AD minimum {text} at {tau_min:.3g} s", zorder=6)
         extra.append(np.array([level]))
     total = report.implied_av(channel, implied)
     curve = np.sqrt(total) ** power
     label = "Implied AD" if deviation else "Implied AV"
     label += " (sum of variances)" if implied == "sum" else " (R: square of summed deviations)"
     ax.plot(av.levels, curve, color=IMPLIED_COLOUR, linewidth=2.0, label=label, zorder=4)
-    limits = log_limits(*drawn, curve, *extra, pad=0.08)  # the flicker plateau and the B marker stay in view
+    limits = log_limits(*drawn, curve, *extra, pad=0.08)
     if limits is not None:
         ax.set_ylim(*limits)
     quantity = "Allan deviation" if deviation else "Allan variance"
@@ -167,6 +204,11 @@ def _panel(ax: Any, report: Any, channel: str, deviation: bool, power: int, impl
                   f"{quantity} [({unit})^2]" if unit else quantity)
     ax.set_xlabel(r"Averaging time $\tau$ [s]")
     kind = report.sensor_types[index]
-    ax.set_title(channel + (f" ({kind.lower()})" if kind else ""))
+    title = channel + (f" ({kind.lower()})" if kind else "")
+    curves = report.curves[report.curves["Channel"] == channel]
+    if len(curves) and curves["Fits"].mean() < 0.9:
+        title += f"\nfit fails at {int((~curves['Fits'].astype(bool)).sum())} of {len(curves)} levels"
+        ax.title.set_color("#B00020")
+    ax.set_title(title, fontsize="small")
     if legend:
         ax.legend(loc="best", fontsize="x-small", framealpha=0.8)

@@ -1,0 +1,161 @@
+"""The rows of a noise report: every fitted term of one channel in SI and customary units.
+
+From a :class:`~avar.fit.sensor_fit.SensorFit` (per-sample variances) to
+the continuous-time coefficients an engineer compares with a datasheet, at
+a sampling rate f (Hz), in data units u:
+
+=====  ==========================  ===================================  ===========
+term   coefficient                 from the per-sample variance c        unit
+=====  ==========================  ===================================  ===========
+QN     quantization Q              sqrt(c) / f                           u s
+WN     angle/velocity random walk  sqrt(c / f)                           u / sqrt(Hz)
+FN     bias instability B          sqrt(c) (AD plateau 0.664 B)          u
+RW     rate/accel. random walk K   sqrt(c f)                             u sqrt(Hz) / s
+DR     ramp R                      sqrt(c) f                             u / s
+AR1    Gauss-Markov sigma, T       sqrt(c / (1 - phi^2)); -1 / (f ln phi)  u; s
+SIN    sinusoid amplitude, f0      sqrt(2 c); shape * f                  u; Hz
+=====  ==========================  ===================================  ===========
+
+Intervals: the squared coefficient c with sampling variance v is a scaled
+chi-square with 2 c^2 / v degrees of freedom; shapes get a normal interval
+(on the log scale for a correlation time). A term left out of the model is
+``absent``, except the three an engineer always needs (N, B, K): those are
+``bound``, with the one-sided 95 % upper bound of the enlarged model.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from avar.fit.noise_terms import ACCEL, GYRO, TERM_NAMES, customary, to_si, unit_of
+from avar.fit.sensor_fit import SensorFit, term_bound
+
+__all__ = ["channel_rows", "minimum_row", "BOUNDED", "ROW_COLUMNS"]
+
+#: Terms reported as a bound when the selection leaves them out.
+BOUNDED = ("WN", "FN", "RW")
+ROW_COLUMNS = ["Channel", "Sensor", "Term", "Process", "Status", "Value", "Lower", "Upper", "Unit", "Customary",
+               "Customary lower", "Customary upper", "Customary unit", "Tau (s)", "Note"]
+CONVERSIONS = {
+    "QN": lambda c, f: math.sqrt(c) / f,
+    "WN": lambda c, f: math.sqrt(c / f),
+    "FN": lambda c, f: math.sqrt(c),
+    "RW": lambda c, f: math.sqrt(c * f),
+    "DR": lambda c, f: math.sqrt(c) * f,
+}
+DEG = math.pi / 180.0
+G0 = 9.80665
+
+
+def _chi2_interval(c: float, variance: float, alpha: float) -> tuple[float, float]:
+    from scipy.special import chdtri
+
+    if not (variance > 0 and c > 0):
+        return c, c
+    edf = 2.0 * c * c / variance
+    return c * edf / chdtri(edf, alpha / 2.0), c * edf / chdtri(edf, 1.0 - alpha / 2.0)
+
+
+def _row(channel: str, kind: str | None, term: str, process: str, status: str, unit: str, values: tuple,
+         customary_unit: str = "", customary_values: tuple = (pd.NA, pd.NA, pd.NA), tau: Any = pd.NA,
+         note: str = "") -> dict[str, Any]:
+    return {"Channel": channel, "Sensor": kind or "", "Term": term, "Process": process, "Status": status,
+            "Value": values[0], "Lower": values[1], "Upper": values[2], "Unit": unit,
+            "Customary": customary_values[0], "Customary lower": customary_values[1],
+            "Customary upper": customary_values[2], "Customary unit": customary_unit, "Tau (s)": tau, "Note": note}
+
+
+def _ieee_row(channel: str, kind: str | None, unit: str | None, process: str, status: str,
+              values: tuple, note: str = "") -> dict[str, Any]:
+    si = tuple(pd.NA if v is pd.NA else to_si(v, kind, unit) for v in values)
+    custom, custom_unit = (pd.NA,) * 3, ""
+    if kind in (GYRO, ACCEL):
+        custom_unit = customary(process, 1.0, kind)[1]
+        custom = tuple(pd.NA if v is pd.NA else customary(process, v, kind)[0] for v in si)
+    name = TERM_NAMES[kind][process]
+    if process == "FN":
+        name += " (IEEE 952 B, AD plateau = 0.664 B)"
+    return _row(channel, kind, name, process, status, unit_of(process, kind, unit), si, custom_unit, custom, note=note)
+
+
+def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFit, freq: float,
+                 alpha: float) -> list[dict[str, Any]]:
+    """The rows of one channel: IEEE terms (present, bound or absent), then Gauss-Markov and sinusoid terms."""
+    rows = []
+    by_kind: dict[str, list[int]] = {}
+    for k, component in enumerate(fit.components):
+        by_kind.setdefault(component.kind, []).append(k)
+    for process in ("QN", "WN", "FN", "RW", "DR"):
+        convert = CONVERSIONS[process]
+        if process in by_kind:
+            k = by_kind[process][0]
+            c = fit.components[k].scale
+            low, high = _chi2_interval(c, fit.scale_variance(k), alpha)
+            rows.append(_ieee_row(channel, kind, unit, process, "present",
+                                  (convert(c, freq), convert(low, freq), convert(high, freq))))
+        elif process in BOUNDED:
+            bound = convert(max(term_bound(fit, process, 1.0 - alpha / 2.0), 0.0), freq)
+            rows.append(_ieee_row(channel, kind, unit, process, "bound", (pd.NA, 0.0, bound),
+                                  note=f"not resolved by the data: {100 * (1 - alpha / 2):g} % upper bound"))
+        else:
+            rows.append(_ieee_row(channel, kind, unit, process, "absent", (pd.NA,) * 3, note="rejected by the selection"))
+    data_unit = unit or "u"
+    z = _normal_quantile(alpha)
+    for number, k in enumerate(by_kind.get("AR1", []), start=1):
+        component = fit.components[k]
+        phi, c = component.shape, component.scale
+        low, high = _chi2_interval(c, fit.scale_variance(k), alpha)
+        spread = 1.0 / (1.0 - phi * phi)
+        sigma = tuple(to_si(math.sqrt(v * spread), kind, unit) for v in (c, low, high))
+        time = -1.0 / (freq * math.log(phi))
+        se_log = math.sqrt(max(fit.shape_variance(k), 0.0)) / (phi * abs(math.log(phi)))
+        times = (time, time * math.exp(-z * se_log), time * math.exp(z * se_log))
+        label = f"Gauss-Markov {number}"
+        rows.append(_row(channel, kind, f"{label} sigma", f"AR1_{number}", "present",
+                         _si_unit(kind, unit, data_unit), sigma, tau=time))
+        rows.append(_row(channel, kind, f"{label} correlation time", f"AR1_{number}.T", "present", "s", times))
+    for number, k in enumerate(by_kind.get("SIN", []), start=1):
+        component = fit.components[k]
+        c = component.scale
+        low, high = _chi2_interval(c, fit.scale_variance(k), alpha)
+        amplitude = tuple(to_si(math.sqrt(2.0 * v), kind, unit) for v in (c, low, high))
+        hertz = component.shape * freq
+        spread = z * math.sqrt(max(fit.shape_variance(k), 0.0)) * freq
+        rows.append(_row(channel, kind, f"Sinusoid {number} amplitude", f"SIN_{number}", "present",
+                         _si_unit(kind, unit, data_unit), amplitude, tau=1.0 / hertz))
+        rows.append(_row(channel, kind, f"Sinusoid {number} frequency", f"SIN_{number}.f", "present", "Hz",
+                         (hertz, max(hertz - spread, 0.0), hertz + spread)))
+    return rows
+
+
+def minimum_row(channel: str, kind: str | None, unit: str | None, tau: np.ndarray, adev: np.ndarray,
+                lower: np.ndarray, upper: np.ndarray) -> dict[str, Any]:
+    """The Allan-deviation minimum over the levels (the datasheets' in-run bias stability), with its band."""
+    at = int(np.nanargmin(adev))
+    si = tuple(to_si(float(v[at]), kind, unit) for v in (adev, lower, upper))
+    custom, custom_unit = (pd.NA,) * 3, ""
+    if kind == GYRO:
+        custom, custom_unit = tuple(v / DEG * 3600.0 for v in si), "deg/h"
+    elif kind == ACCEL:
+        custom, custom_unit = tuple(v / (G0 * 1e-6) for v in si), "ug"
+    return _row(channel, kind, "Allan deviation minimum (in-run bias stability)", "MIN", "measured",
+                _si_unit(kind, unit, unit or "u"), si, custom_unit, custom, tau=float(tau[at]),
+                note="the empirical minimum over the levels, with its chi-squared band")
+
+
+def _si_unit(kind: str | None, unit: str | None, fallback: str) -> str:
+    if unit is not None and kind == GYRO:
+        return "rad/s"
+    if unit is not None and kind == ACCEL:
+        return "m/s^2"
+    return fallback
+
+
+def _normal_quantile(alpha: float) -> float:
+    from scipy.special import ndtri
+
+    return float(ndtri(1.0 - alpha / 2.0))
