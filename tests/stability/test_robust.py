@@ -1,0 +1,262 @@
+"""avar.robust_avar and avar.count_outliers: plain twins, closed forms and simulations with known spikes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.ndimage import median_filter
+
+import avar
+from avar._kernels import interpolation_residuals, running_median
+from avar.stability.robust import intact_counts, robust_scale
+
+
+def residuals_loop(x: np.ndarray, flagged: np.ndarray) -> np.ndarray:
+    """Plain twin of interpolation_residuals: np.interp through the unflagged samples other than t."""
+    n = len(x)
+    out = np.empty(n)
+    for t in range(n):
+        keep = ~flagged.copy()
+        keep[t] = False
+        left, right = np.flatnonzero(keep[:t]), t + 1 + np.flatnonzero(keep[t + 1:])
+        if left.size and right.size:
+            a, b = left[-1], right[0]
+            out[t] = x[t] - np.interp(t, [a, b], [x[a], x[b]])
+        elif left.size or right.size:
+            out[t] = x[t] - x[left[-1] if left.size else right[0]]
+        else:
+            out[t] = 0.0
+    return out
+
+
+def median_loop(x: np.ndarray, half: int) -> np.ndarray:
+    """Plain twin of running_median: the median of the mirrored window, sample by sample."""
+    n = len(x)
+
+    def mirror(i):
+        i = -i if i < 0 else i
+        i = 2 * (n - 1) - i if i >= n else i
+        return min(max(i, 0), n - 1)
+
+    return np.array([sorted(x[mirror(i)] for i in range(t - half, t + half + 1))[half] for t in range(n)])
+
+
+def mo_loop(x: np.ndarray, m: int, bad: np.ndarray | None = None) -> float:
+    """The "mo" Allan variance as a loop over its differences, skipping those that touch a flagged sample."""
+    total, count = 0.0, 0
+    for t in range(len(x) - 2 * m + 1):
+        if bad is not None and bad[t:t + 2 * m].any():
+            continue
+        d = x[t + m:t + 2 * m].mean() - x[t:t + m].mean()
+        total += d * d / 2
+        count += 1
+    return total / count
+
+
+def white_plus_walk(n: int, seed: int, sigma: float = 1.0, gamma: float = 0.01) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return sigma * rng.standard_normal(n) + np.cumsum(gamma * rng.standard_normal(n))
+
+
+def add_spikes(x: np.ndarray, rate: float, size: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    where = np.sort(rng.choice(x.size, int(round(rate * x.size)), replace=False))
+    spiky = x.copy()
+    spiky[where] += size * rng.choice([-1.0, 1.0], where.size)
+    return spiky, where
+
+
+# --------------------------------------------------------------------------- the kernel and helpers
+@pytest.mark.parametrize("n", [2, 3, 5, 40, 300])
+@pytest.mark.parametrize("density", [0.0, 0.1, 0.5, 1.0])
+def test_interpolation_residuals_match_loop(n, density):
+    rng = np.random.default_rng(n)
+    x = np.cumsum(rng.standard_normal(n)) + 100.0
+    flagged = rng.random(n) < density
+    out = np.empty(n)
+    interpolation_residuals(x, flagged, out)
+    np.testing.assert_allclose(out, residuals_loop(x, flagged), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 11, 12, 300])
+@pytest.mark.parametrize("half", [0, 1, 5])
+def test_running_median_matches_loop(n, half):
+    x = np.round(np.random.default_rng(n * 10 + half).standard_normal(n), 1)  # ties on purpose
+    out = np.empty(n)
+    running_median(x, half, out)
+    np.testing.assert_array_equal(out, median_loop(x, half))
+    if n > half:
+        np.testing.assert_array_equal(out, median_filter(x, 2 * half + 1, mode="mirror"))
+
+
+def test_residuals_of_a_spike_and_the_line_that_skips_it():
+    x = np.zeros(9)
+    x[4] = 10.0
+    residuals = np.empty(9)
+    flagged = np.zeros(9, dtype=bool)
+    interpolation_residuals(x, flagged, residuals)
+    assert residuals.tolist() == [0, 0, 0, -5, 10, -5, 0, 0, 0]
+    flagged[4] = True
+    interpolation_residuals(x, flagged, residuals)
+    assert residuals.tolist() == [0, 0, 0, 0, 10, 0, 0, 0, 0]
+
+
+def test_intact_counts_match_a_loop():
+    rng = np.random.default_rng(3)
+    n = 400
+    bad = rng.random(n) < 0.03
+    bad[[0, 1, n - 1]] = True
+    factors = np.array([1, 2, 3, 8, 50, 200])
+    loop = [sum(not bad[t:t + 2 * m].any() for t in range(n - 2 * m + 1)) for m in factors]
+    assert intact_counts(np.flatnonzero(bad), n, factors).tolist() == loop
+
+
+def test_robust_scale_of_gaussian_and_quantized_noise():
+    rng = np.random.default_rng(0)
+    assert robust_scale(3.0 * rng.standard_normal(200_000)) == pytest.approx(3.0, rel=0.01)
+    # 95 % of the residuals are 0: the MAD is 0; the clipped standard deviation keeps the +-1 steps, not the spike
+    quantized = np.zeros(1000)
+    quantized[:50] = np.tile([1.0, -1.0], 25)
+    quantized[500] = 100.0
+    assert robust_scale(quantized) == pytest.approx(np.sqrt(50 / 999) / 0.9865783925581086)
+    assert robust_scale(np.full(10, 4.0)) == 0.0
+
+
+# --------------------------------------------------------------------------- count_outliers
+@pytest.mark.parametrize("walk", [0.0, 0.05])
+def test_count_outliers_finds_known_spikes(walk):
+    x = white_plus_walk(100_000, 1, gamma=walk)
+    spiky, where = add_spikes(x, 0.01, 12.0, seed=2)
+    found = avar.count_outliers(spiky)
+    assert abs(found.count - where.size) <= 3
+    assert np.isin(where, found.indices).mean() > 0.99
+    # residual x_t - (x_{t-1} + x_{t+1}) / 2: variance 1.5 sigma**2 + gamma**2 / 2, not inflated by the spikes
+    assert found.scale == pytest.approx(np.sqrt(1.5 + walk**2 / 2), rel=0.02)
+    assert found.fraction == found.count / 100_000 and int(found) == found.count
+    assert "beyond 6 robust SD" in repr(found)
+    assert np.array_equal(avar.count_outliers(spiky, threshold=6).indices, found.indices)
+
+
+@pytest.mark.parametrize("kind", ["white", "walk", "white+walk"])
+def test_count_outliers_on_clean_gaussian_series_is_zero(kind):
+    rng = np.random.default_rng(11)
+    steps = rng.standard_normal(200_000)
+    x = {"white": steps, "walk": np.cumsum(steps), "white+walk": white_plus_walk(200_000, 4, gamma=0.3)}[kind]
+    assert avar.count_outliers(x).count == 0
+    assert avar.count_outliers(x, threshold=4.0).count < 200_000 * 2e-3  # Gaussian tail beyond ~4 sd: 6e-5
+
+
+def test_count_outliers_of_adjacent_spikes_and_a_burst():
+    x = np.random.default_rng(5).standard_normal(3000)
+    truth = [10, 11, 500, 1000, 1001, 1002, 2999]
+    x[truth] += [25.0, -25.0, 30.0, 40.0, 40.0, 40.0, 30.0]
+    assert avar.count_outliers(x).indices.tolist() == truth
+    assert avar.count_outliers(pd.Series(x), threshold=100.0).count == 0
+
+
+def test_count_outliers_of_quantized_data():
+    rng = np.random.default_rng(6)
+    x = np.round(rng.standard_normal(20_000) * 0.3)  # 1 LSB steps, most samples 0
+    x[[50, 900]] = [40.0, -40.0]
+    assert avar.count_outliers(x).indices.tolist() == [50, 900]
+
+
+# --------------------------------------------------------------------------- robust_avar
+def test_without_outliers_it_is_the_ordinary_allan_variance():
+    x = white_plus_walk(5000, 5) + 1e6
+    res = avar.robust_avar(x, freq=100.0, taus="decade")
+    ref = avar.avar(x, type="mo", freq=100.0, taus="decade")
+    assert res.outliers.count == 0 and res.type == "mo"
+    np.testing.assert_array_equal(res.averaging_factors, ref.averaging_factors)
+    np.testing.assert_allclose(res.levels, ref.levels)
+    np.testing.assert_allclose(res.allan, ref.allan, rtol=1e-12)
+    np.testing.assert_array_equal(res.n_differences, ref.n_differences)
+    assert res.intact.all() and np.all(res.contaminated == 0)
+    assert isinstance(res, avar.AllanVariance)
+
+
+def test_intact_and_filled_levels_match_plain_loops():
+    x = white_plus_walk(1200, 8)
+    spiky, where = add_spikes(x, 0.05, 30.0, seed=9)
+    res = avar.robust_avar(spiky, taus="all")
+    assert res.outliers.indices.tolist() == where.tolist()
+    bad = np.zeros(spiky.size, dtype=bool)
+    bad[where] = True
+    keep = ~bad
+    filled = spiky.copy()
+    filled[bad] = np.interp(where, np.flatnonzero(keep), spiky[keep])
+    assert res.intact[0] and not res.intact[-1]
+    for j, m in enumerate(res.averaging_factors[:80]):
+        expected = mo_loop(spiky, m, bad) if res.intact[j] else mo_loop(filled, m)
+        assert res.allan[j] == pytest.approx(expected, rel=1e-10), m
+        if res.intact[j]:
+            assert res.n_differences[j] == sum(not bad[t:t + 2 * m].any() for t in range(spiky.size - 2 * m + 1))
+    total = spiky.size - 2 * res.averaging_factors + 1
+    np.testing.assert_allclose(res.contaminated, 1 - intact_counts(where, spiky.size, res.averaging_factors) / total)
+
+
+@pytest.mark.parametrize("process", ["white", "walk"])
+def test_consistent_on_clean_gaussian_data(process):
+    """Expectation equals the closed form within sampling error; no loss against the ordinary estimator."""
+    n = 2**18
+    rng = np.random.default_rng(21)
+    steps = rng.standard_normal(n)
+    x = steps if process == "white" else np.cumsum(steps)
+    res = avar.robust_avar(x)
+    ordinary = avar.avar(x)
+    m = res.averaging_factors
+    theory = avar.av_wn(1.0, m) if process == "white" else avar.av_rw(1.0, m)
+    useful = n / (2 * m) >= 100
+    # relative standard error of the "mo" AV: about sqrt(2 m / N) (white), sqrt(3 m / N) (random walk)
+    bound = 4 * np.sqrt(3 * m / n)
+    assert np.all(np.abs(res.allan[useful] / theory[useful] - 1) < bound[useful])
+    assert res.outliers.count <= 2  # a Gaussian sample beyond 5 sd: probability 6e-7
+    np.testing.assert_allclose(res.allan, ordinary.allan, rtol=1e-3)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_resists_five_percent_spikes_of_20_sigma(seed):
+    n = 2**17
+    clean = white_plus_walk(n, seed)
+    spiky, where = add_spikes(clean, 0.05, 20.0, seed=seed + 100)
+    reference = avar.avar(clean, freq=200.0)
+    res = avar.robust_avar(spiky, freq=200.0)
+    ordinary = avar.avar(spiky, freq=200.0)
+    useful = n / (2 * reference.averaging_factors) >= 100
+    assert useful.sum() >= 9
+    ratio = res.allan / reference.allan
+    assert np.all(np.abs(ratio[useful] - 1) < 0.10), ratio
+    assert np.all(ordinary.allan[:6] / reference.allan[:6] > 10)  # the spikes dominate the ordinary AV
+    assert abs(res.outliers.count - where.size) <= 0.01 * where.size
+    # the breakdown measure: about 1 - (1 - p)**(2m) of the differences touch a spike
+    np.testing.assert_allclose(res.contaminated[:4], 1 - 0.95 ** (2 * res.averaging_factors[:4]), atol=0.02)
+    assert res.intact[0] and not res.intact[useful].all()
+
+
+def test_levels_follow_avar_grids():
+    x = add_spikes(white_plus_walk(3000, 2), 0.02, 20.0, 3)[0]
+    for taus in ("octave", "decade", "all", [0.1, 0.5, 2.0]):
+        res = avar.robust_avar(x, freq=10.0, taus=taus)
+        np.testing.assert_array_equal(res.averaging_factors, avar.avar(x, freq=10.0, taus=taus).averaging_factors)
+        assert len(res.intact) == len(res) and res.freq == 10.0
+    assert "robust: 60 outlying samples" in res.describe()
+    assert set(res.summary().columns) >= {"Time", "AVar", "ADev"}
+
+
+@pytest.mark.parametrize("kwargs, error, words", [
+    (dict(threshold=0.0), ValueError, "threshold must be > 0"),
+    (dict(threshold="5"), TypeError, "threshold must be a real number"),
+    (dict(threshold=float("nan")), ValueError, "threshold must be finite"),
+    (dict(freq=-1.0), ValueError, "freq"),
+])
+def test_validation_names_the_argument(kwargs, error, words):
+    with pytest.raises(error, match=words):
+        avar.robust_avar(np.arange(100.0), **kwargs)
+
+
+def test_validation_of_the_series():
+    with pytest.raises(ValueError, match="x must be 1-D"):
+        avar.count_outliers(np.zeros((10, 2)))
+    with pytest.raises(ValueError, match="x"):
+        avar.robust_avar(np.array([1.0, np.nan, 2.0, 3.0]))
