@@ -8,7 +8,7 @@ import pytest
 from scipy.ndimage import median_filter
 
 import avar
-from avar._kernels import interpolation_residuals, running_median
+from avar._kernels import intact_squares, interpolation_residuals, release_candidates, running_median
 from avar.stability.robust import intact_counts, robust_scale
 
 
@@ -260,3 +260,41 @@ def test_validation_of_the_series():
         avar.count_outliers(np.zeros((10, 2)))
     with pytest.raises(ValueError, match="x"):
         avar.robust_avar(np.array([1.0, np.nan, 2.0, 3.0]))
+
+
+def release_loop(x: np.ndarray, flagged: np.ndarray, limit: float) -> np.ndarray:
+    """Plain twin of release_candidates: residuals of the whole pass first, then the releases."""
+    flagged = flagged.copy()
+    while True:
+        residuals = residuals_loop(x, flagged)
+        released = flagged & (np.abs(residuals) <= limit)
+        if not released.any():
+            return flagged
+        flagged &= ~released
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_release_candidates_matches_loop(seed):
+    rng = np.random.default_rng(seed)
+    x = np.cumsum(rng.standard_normal(300))
+    x[rng.choice(300, 6, replace=False)] += 15.0
+    candidates = np.abs(x - median_loop(x, 5)) > 1.0
+    flagged = candidates.copy()
+    residuals = np.empty(300)
+    passes = release_candidates(x, flagged, residuals, 6.0, 50)
+    np.testing.assert_array_equal(flagged, release_loop(x, candidates, 6.0))
+    np.testing.assert_allclose(residuals, residuals_loop(x, flagged), atol=1e-12)
+    assert 1 <= passes < 50 and flagged.sum() >= 5
+
+
+@pytest.mark.parametrize("m", [1, 3, 17, 600])
+def test_intact_squares_matches_loop(m):
+    rng = np.random.default_rng(m)
+    x = np.cumsum(rng.standard_normal(3000)) + 1e3  # an offset and a walk: the sliding sum must not drift
+    flagged = rng.random(3000) < (0.02 if m < 100 else 0.0005)
+    centred = x - x.mean()
+    squares, used = intact_squares(centred, flagged, m)
+    expected = [(centred[t + m:t + 2 * m].sum() - centred[t:t + m].sum()) ** 2
+                for t in range(3000 - 2 * m + 1) if not flagged[t:t + 2 * m].any()]
+    assert used == len(expected) > 0
+    assert squares == pytest.approx(sum(expected), rel=1e-11)

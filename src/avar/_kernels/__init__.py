@@ -44,5 +44,10 @@ from avar._kernels.allan import (  # noqa: E402
 )
 from avar._kernels.columns import allan_variance_columns as streaming_allan_variance  # noqa: E402
 from avar._kernels.covariance import COV_TILE, NOAV_SCAN_RATIO, covariance_pass, moav_from_sums  # noqa: E402
-from avar._kernels.robust import interpolation_residuals, running_median  # noqa: E402
+from avar._kernels.robust import (  # noqa: E402
+    intact_squares,
+    interpolation_residuals,
+    release_candidates,
+    running_median,
+)
 from avar._kernels.simulation import ar1_recursion  # noqa: E402

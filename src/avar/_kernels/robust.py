@@ -88,3 +88,68 @@ def running_median(x, half, out):
                 j -= 1
             window[j] = entering
         out[t] = window[half]
+
+
+@njit(cache=True)
+def release_candidates(x, flagged, residuals, limit, max_passes):
+    """Unflag, pass after pass, the flagged t with |x[t] - line(t)| <= limit, until none is released.
+
+    Each pass computes every residual from the lines through the samples
+    unflagged at its start (:func:`interpolation_residuals`), then releases;
+    ``flagged`` (bool) is updated in place and ``residuals`` holds the last
+    pass's residuals. Returns the number of passes.
+    """
+    n = x.shape[0]
+    passes = 0
+    while passes < max_passes:
+        passes += 1
+        interpolation_residuals(x, flagged, residuals)
+        released = 0
+        for t in range(n):
+            if flagged[t] and abs(residuals[t]) <= limit:
+                flagged[t] = False
+                released += 1
+        if released == 0:
+            break
+    return passes
+
+
+#: The intact differences' running sum is recomputed from scratch every REFRESH steps (bounds its rounding drift).
+REFRESH = 1024
+
+
+@njit(cache=True)
+def _difference(x, t, m):
+    total = 0.0
+    for i in range(m):
+        total += x[t + m + i] - x[t + i]
+    return total
+
+
+@njit(cache=True)
+def intact_squares(x, flagged, m):
+    """Sum of D_t**2 and their count over the t whose 2m samples t..t+2m-1 hold no flagged sample.
+
+    D_t = sum_{i<m} (x[t+m+i] - x[t+i]) = m (ybar_{t+m}(m) - ybar_t(m)), so the
+    "mo" Allan variance of those differences is sum / (2 m**2 count). ``x``
+    float64 (mean removed, flagged samples replaced by finite values: they
+    never enter a counted D_t), ``flagged`` bool, 1 <= m <= n // 2. D_t
+    slides in O(1) per step and is recomputed every ``REFRESH`` steps.
+    """
+    n = x.shape[0]
+    bad = 0
+    for i in range(2 * m):
+        bad += flagged[i]
+    total = 0.0
+    count = 0
+    d = 0.0
+    for t in range(n - 2 * m + 1):
+        if t % REFRESH == 0:
+            d = _difference(x, t, m)
+        if bad == 0:
+            total += d * d
+            count += 1
+        if t + 2 * m < n:
+            d += (x[t + 2 * m] - x[t + m]) - (x[t + m] - x[t])
+            bad += flagged[t + 2 * m] - flagged[t]
+    return total, count

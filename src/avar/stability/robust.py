@@ -16,7 +16,6 @@ import numpy as np
 from avar import _kernels
 from avar._validation import as_series, check_real
 from avar.stability.columns import allan_variance_columns
-from avar.stability.deviation_core import deviation_levels
 from avar.stability.grids import averaging_factors, n_differences
 from avar.stability.intervals import relative_errors
 from avar.stability.robust_results import Outliers, RobustAllanVariance
@@ -49,9 +48,13 @@ def robust_scale(residuals: np.ndarray) -> float:
     >>> round(robust_scale(np.array([0.0] * 9 + [1.0, -1.0, 0.0])), 4)
     0.4138
     """
-    centred = residuals - np.median(residuals)
-    scale = MAD_TO_SD * float(np.median(np.abs(centred)))
-    if scale > 0 or centred.size == 0:
+    if residuals.size == 0:
+        return 0.0
+    centred = np.array(residuals, dtype=np.float64)  # one copy, reordered by the in-place medians
+    centred -= np.median(centred, overwrite_input=True)
+    spread = np.abs(centred)
+    scale = MAD_TO_SD * float(np.median(spread, overwrite_input=True))
+    if scale > 0:
         return scale
     step = float(np.min(np.abs(centred[centred != 0]), initial=np.inf))  # the smallest quantization step
     scale = float(np.sqrt(np.mean(centred * centred)))
@@ -87,15 +90,8 @@ def flag_outliers(values: np.ndarray, threshold: float) -> Outliers:
     candidates = np.abs(departure) > threshold / 2 * min(robust_scale(departure), scale)
     for final in (False, True):
         flagged = candidates.copy()
-        for _ in range(MAX_PASSES):
-            _kernels.interpolation_residuals(values, flagged, residuals)
-            kept = flagged & (np.abs(residuals) > threshold * scale)
-            settled = np.array_equal(kept, flagged)
-            flagged = kept
-            if settled:
-                break
+        _kernels.release_candidates(values, flagged, residuals, threshold * scale, MAX_PASSES)
         if not final and not flagged.all():
-            _kernels.interpolation_residuals(values, flagged, residuals)
             scale = robust_scale(residuals[~flagged])
     indices = np.flatnonzero(flagged)
     return Outliers(count=int(indices.size), indices=indices, n=n, threshold=threshold, scale=scale)
@@ -289,18 +285,20 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
     if outliers.count == 0:
         intact[:] = True
     allan = np.empty(factors.size)
-    if outliers.count and intact.any():
-        gappy = values.copy()
-        gappy[outliers.indices] = np.nan
-        allan[intact], _ = deviation_levels("oadev", gappy, factors[intact], "freq", rate)
-    if not intact.all() or outliers.count == 0:
-        filled = values
-        if outliers.count:
-            keep = np.ones(n, dtype=bool)
-            keep[outliers.indices] = False
-            filled = values.copy()
-            filled[~keep] = np.interp(outliers.indices, np.flatnonzero(keep), values[keep])
-        rest = ~intact if outliers.count else intact
+    filled = values
+    if outliers.count:
+        keep = np.ones(n, dtype=bool)
+        keep[outliers.indices] = False
+        filled = values.copy()
+        filled[~keep] = np.interp(outliers.indices, np.flatnonzero(keep), values[keep])
+        if intact.any():
+            centred = filled - filled.mean()
+            for j in np.flatnonzero(intact):
+                m = int(factors[j])
+                squares, used = _kernels.intact_squares(centred, ~keep, m)
+                allan[j] = squares / (2.0 * m * m * used)
+    rest = ~intact if outliers.count else intact
+    if rest.any():
         allan[rest] = allan_variance_columns(filled[:, None], factors[rest], "mo")[0]
     return RobustAllanVariance(
         levels=factors / rate, averaging_factors=factors, allan=allan, errors=relative_errors(n, factors),
