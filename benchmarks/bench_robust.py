@@ -12,7 +12,8 @@ without the spikes, level by level, over seeds (median and largest |ratio - 1|):
 * ``ordinary``: ``avar.avar`` of the spiky series;
 * ``robust``: ``avar.robust_avar`` (the library's choice: intact or filled per level);
 * ``filled``: the ordinary AV of the series with the flagged samples
-  interpolated (the library's estimator at every level);
+  interpolated, without subtracting the fill's excess (the library's
+  filled levels subtract it);
 * ``intact``: only differences free of flagged samples (``avar.avar(...,
   nan_policy="omit")`` with them as NaN; the library's estimator at every level);
 * ``M-wavelet``: an M-estimator of the Haar wavelet variance in the style of

@@ -188,7 +188,12 @@ def test_intact_and_filled_levels_match_plain_loops():
     filled[bad] = np.interp(where, np.flatnonzero(keep), spiky[keep])
     assert res.intact[0] and not res.intact[-1]
     for j, m in enumerate(res.averaging_factors[:80]):
-        expected = mo_loop(spiky, m, bad) if res.intact[j] else mo_loop(filled, m)
+        if res.intact[j]:
+            expected = mo_loop(spiky, m, bad)
+        else:  # less the white noise's fill excess p s**2 / m, at most a share 1.5 p / (1 + 1.5 p)
+            raw = mo_loop(filled, m)
+            p, s2 = where.size / spiky.size, res.outliers.scale**2
+            expected = raw - min(p * s2 / m, raw * 1.5 * p / (1 + 1.5 * p))
         assert res.allan[j] == pytest.approx(expected, rel=1e-10), m
         if res.intact[j]:
             assert res.n_differences[j] == sum(not bad[t:t + 2 * m].any() for t in range(spiky.size - 2 * m + 1))
@@ -232,6 +237,20 @@ def test_resists_five_percent_spikes_of_20_sigma(seed):
     # the breakdown measure: about 1 - (1 - p)**(2m) of the differences touch a spike
     np.testing.assert_allclose(res.contaminated[:4], 1 - 0.95 ** (2 * res.averaging_factors[:4]), atol=0.02)
     assert res.intact[0] and not res.intact[useful].all()
+
+
+def test_the_fill_excess_of_white_noise_is_removed():
+    """White noise, 5 % spikes: an interpolated sample adds 1.5 sigma**2 to a cluster sum; the filled levels
+    would be 7.5 % high, and are not once p s**2 / m is subtracted."""
+    n = 2**17
+    clean = np.random.default_rng(31).standard_normal(n)
+    spiky, _ = add_spikes(clean, 0.05, 20.0, seed=32)
+    res = avar.robust_avar(spiky)
+    filled = ~res.intact & (n / (2 * res.averaging_factors) >= 100)
+    assert filled.sum() >= 4
+    assert res.outliers.scale == pytest.approx(np.sqrt(1.5), rel=0.02)
+    ratio = (res.allan / avar.avar(clean).allan)[filled]
+    assert abs(np.mean(ratio) - 1) < 0.025 and np.all(np.abs(ratio - 1) < 0.06), ratio
 
 
 def test_levels_follow_avar_grids():

@@ -180,6 +180,23 @@ def intact_counts(flagged: np.ndarray, n: int, factors: np.ndarray) -> np.ndarra
     return np.array([np.maximum(runs - 2 * m + 1, 0).sum() for m in factors], dtype=np.int64)
 
 
+def fill_excess(raw: np.ndarray, factors: np.ndarray, fraction: float, scale: float) -> np.ndarray:
+    """What interpolating a fraction ``fraction`` of the samples adds to the "mo" AV(m) of white noise.
+
+    Each interpolated sample adds the variance of its interpolation error
+    to a cluster sum: ``scale**2`` (the robust variance of the residual
+    x_t - (x_{t-1} + x_{t+1}) / 2, 1.5 sigma**2 for white noise); a
+    difference spans 2m samples, so AV(m) gains p s**2 / m. Never more than
+    white noise's share of ``raw``, raw * 1.5 p / (1 + 1.5 p): for a random
+    walk the excess is negligible (s**2 = gamma**2 / 2 against gamma**2 m / 3).
+
+    >>> fill_excess(np.array([0.5 * 1.075, 0.25]), np.array([2, 4]), 0.05, np.sqrt(1.5)).round(4).tolist()
+    [0.0375, 0.0174]
+    """
+    white = fraction * scale * scale / factors
+    return np.minimum(white, raw * FILL_BIAS * fraction / (1.0 + FILL_BIAS * fraction))
+
+
 def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
                           threshold: float = 5.0) -> RobustAllanVariance:
     """Allan variance ("mo") of the clean process behind a series with spikes.
@@ -197,11 +214,13 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
       lost (p the flagged fraction), all of them at large m.
     * **filled**: the ordinary "mo" estimator of the series with each flagged
       sample replaced by linear interpolation between its unflagged
-      neighbours. Every difference is kept; a random walk or drift is
-      interpolated exactly, but a white noise's AV is raised by at most
-      1.5 p relative (an interpolated sample adds 2 (1.5**2 - 1) - 1 = 1.5
-      to the variance of a cluster sum; any level-preserving linear fill
-      adds at least 1).
+      neighbours, less the fill's excess (:func:`fill_excess`). Every
+      difference is kept; a random walk or drift is interpolated almost
+      exactly, but white noise is not: an interpolated sample adds the
+      variance of its interpolation error, s**2 (= 1.5 sigma**2), to a
+      cluster sum, i.e. p s**2 / m to AV(m), 1.5 p relative (any
+      level-preserving linear fill adds at least p sigma**2 / m), and this
+      excess is subtracted.
 
     A level is ``intact`` when its relative sampling error, about
     sqrt(2 m / C) for C intact differences, is at most the fill's bias bound
@@ -224,9 +243,14 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
 
     Where it can no longer resist: spikes smaller than ``threshold`` robust
     standard deviations are not flagged and count fully (at most
-    threshold**2 scale**2 each); a burst longer than a few samples looks
-    like a step and is not flagged; and a filled level keeps the bias bound 1.5 p, so a flagged fraction above
-    ~7 % can raise white-noise-dominated levels by more than 10 %.
+    threshold**2 scale**2 each); a burst longer than 5 samples looks like a
+    step and is not flagged; and the filled levels assume the noise at the
+    sampling rate is white or smoother: for quantization noise (AV
+    proportional to 1 / m**2, a "blue" noise whose cluster sums telescope)
+    an interpolated sample breaks the telescoping, and a filled level is
+    raised by about p s**2 / m, which dominates at large m (with 5 % spikes
+    on pure quantization noise, 3.3x at m = 32 and more beyond). Real sensors have white
+    noise above quantization noise beyond the shortest taus.
 
     Parameters
     ----------
@@ -299,7 +323,8 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
                 allan[j] = squares / (2.0 * m * m * used)
     rest = ~intact if outliers.count else intact
     if rest.any():
-        allan[rest] = allan_variance_columns(filled[:, None], factors[rest], "mo")[0]
+        raw = allan_variance_columns(filled[:, None], factors[rest], "mo")[0]
+        allan[rest] = raw - fill_excess(raw, factors[rest], outliers.fraction, outliers.scale)
     return RobustAllanVariance(
         levels=factors / rate, averaging_factors=factors, allan=allan, errors=relative_errors(n, factors),
         n_differences=np.where(intact, counts, total), type="mo", freq=rate, n=n, outliers=outliers,
