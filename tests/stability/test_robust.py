@@ -317,3 +317,16 @@ def test_intact_squares_matches_loop(m):
                 for t in range(3000 - 2 * m + 1) if not flagged[t:t + 2 * m].any()]
     assert used == len(expected) > 0
     assert squares == pytest.approx(sum(expected), rel=1e-11)
+
+
+def test_huge_and_tiny_magnitudes_scale_exactly():
+    x = white_plus_walk(4000, 12)
+    spiky, where = add_spikes(x, 0.05, 20.0, seed=13)
+    base = avar.robust_avar(spiky)
+    assert base.intact.any()
+    for factor in (2.0**500, 2.0**-600):
+        res = avar.robust_avar(spiky * factor)
+        np.testing.assert_array_equal(res.outliers.indices, base.outliers.indices)
+        np.testing.assert_allclose(res.allan, base.allan * factor**2, rtol=1e-12)
+    with pytest.raises(ValueError, match="overflows float64"):
+        avar.robust_avar(spiky * 1e306)

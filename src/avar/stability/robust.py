@@ -316,11 +316,16 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
         filled = values.copy()
         filled[~keep] = np.interp(outliers.indices, np.flatnonzero(keep), values[keep])
         if intact.any():
-            centred = filled - filled.mean()
+            exponent = int(np.frexp(np.max(np.abs(filled)))[1])  # |filled| < 2**exponent: an exact rescaling
+            centred = np.ldexp(filled, -exponent)
+            centred -= centred.mean()
             for j in np.flatnonzero(intact):
                 m = int(factors[j])
                 squares, used = _kernels.intact_squares(centred, ~keep, m)
-                allan[j] = squares / (2.0 * m * m * used)
+                with np.errstate(over="ignore"):  # reported below
+                    allan[j] = np.ldexp(squares / (2.0 * m * m * used), 2 * exponent)
+            if not np.isfinite(allan[intact]).all():
+                raise ValueError("the Allan variance overflows float64; rescale the data, e.g. to other units")
     rest = ~intact if outliers.count else intact
     if rest.any():
         raw = allan_variance_columns(filled[:, None], factors[rest], "mo")[0]
