@@ -24,6 +24,8 @@ from avar.stability.robust_results import Outliers, RobustAllanVariance
 MAD_TO_SD = 1.482602218505602
 #: Standard deviation of a standard Gaussian cut at +-3: sqrt(1 - 6 phi(3) / (2 Phi(3) - 1)).
 CLIPPED_SD = 0.9865783925581086
+#: Samples read by the preliminary robust scales (every k-th): their relative standard error is ~1.2 / sqrt(this).
+PRELIMINARY_SAMPLES = 2**17
 #: Half width of the running median that finds the candidates (11 samples).
 MEDIAN_HALF_WIDTH = 5
 #: The fill's bias bound per flagged fraction p: linear interpolation adds 1.5 p to white noise's AV.
@@ -67,6 +69,11 @@ def robust_scale(residuals: np.ndarray) -> float:
     return scale / CLIPPED_SD
 
 
+def _every_kth(values: np.ndarray) -> np.ndarray:
+    """At most about PRELIMINARY_SAMPLES evenly spaced values (a view): enough for a preliminary scale."""
+    return values[::max(1, values.size // PRELIMINARY_SAMPLES)]
+
+
 def flag_outliers(values: np.ndarray, threshold: float) -> Outliers:
     """Flag the samples whose interpolation residual exceeds threshold robust SDs (validated float64 input).
 
@@ -78,16 +85,18 @@ def flag_outliers(values: np.ndarray, threshold: float) -> Outliers:
     F, until F settles (a clean sample whose line spanned other candidates
     is released once they are). Twice: the second time with s the robust
     scale of r outside F (the first s counts the spikes' residuals too).
+    The two preliminary scales (s_med and the first s) read every k-th
+    sample, at most about ``PRELIMINARY_SAMPLES`` (relative error ~0.3 %).
     """
     n = values.size
     flagged = np.zeros(n, dtype=bool)
     residuals = np.empty(n)
     _kernels.interpolation_residuals(values, flagged, residuals)
-    scale = robust_scale(residuals)
+    scale = robust_scale(_every_kth(residuals))
     median = np.empty(n)
     _kernels.running_median(values, MEDIAN_HALF_WIDTH, median)
     departure = values - median
-    candidates = np.abs(departure) > threshold / 2 * min(robust_scale(departure), scale)
+    candidates = np.abs(departure) > threshold / 2 * min(robust_scale(_every_kth(departure)), scale)
     for final in (False, True):
         flagged = candidates.copy()
         _kernels.release_candidates(values, flagged, residuals, threshold * scale, MAX_PASSES)
