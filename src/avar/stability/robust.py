@@ -22,51 +22,77 @@ from avar.stability.robust_results import Outliers, RobustAllanVariance
 
 #: 1 / Phi^{-1}(3/4): the MAD of a Gaussian times this is its standard deviation.
 MAD_TO_SD = 1.482602218505602
-#: Standard deviation of a standard Gaussian cut at +-3: sqrt(1 - 6 phi(3) / (2 Phi(3) - 1)).
-CLIPPED_SD = 0.9865783925581086
+#: Interquartile range of a standard Gaussian, 2 Phi^{-1}(3/4).
+IQR_TO_SD = 1.3489795003921634
+#: Share of residuals tied with their MAD beyond which the data are taken as quantized.
+GROUPED_TIES = 0.01
 #: Samples read by the preliminary robust scales (every k-th): their relative standard error is ~1.2 / sqrt(this).
 PRELIMINARY_SAMPLES = 2**17
 #: Half width of the running median that finds the candidates (11 samples).
 MEDIAN_HALF_WIDTH = 5
 #: The fill's bias bound per flagged fraction p: linear interpolation adds 1.5 p to white noise's AV.
 FILL_BIAS = 1.5
-#: Passes of the clipped standard deviation at most (it settles in a few).
+#: Passes of the candidates' release at most (it settles in a few).
 MAX_PASSES = 50
 
 
 def robust_scale(residuals: np.ndarray) -> float:
     """Robust standard deviation of ``residuals``: 1.4826 median|r - median r|.
 
-    Quantized data can have a MAD of 0 (most residuals exactly 0, the
-    others whole steps): then the standard deviation of the residuals
-    within 3 standard deviations of their median (never closer than the
-    smallest nonzero |r - median r|, one quantization step), iterated until
-    it settles and divided by 0.98658 (the standard deviation of a Gaussian
-    cut at +-3 sd): it sees the quantization steps and not the spikes. 0
-    only when every residual equals the median; a series that is constant
-    but for its spikes has the spikes as its smallest step, hence as its
-    scale, and they are not flagged.
+    Quantized data (a sensor whose step is comparable to its noise) take
+    few distinct values, and their MAD is a whole or half step: 0, or up to
+    50 % off. When more than 1 % of the |r - median r| equal the MAD, the
+    scale is instead (Q3 - Q1) / 1.349 with grouped-data quartiles: each
+    value spread uniformly over its quantization bin (the smallest gap
+    between distinct values), i.e. the quartiles of the data plus uniform
+    dither, whose standard deviation is sqrt(sigma**2 + step**2 / 12)
+    (Sheppard). 0 only when every residual is equal. A series that is
+    constant but for its spikes has the spikes as its step, and they are
+    not flagged.
 
     >>> round(robust_scale(np.array([0.0] * 9 + [1.0, -1.0, 0.0])), 4)
-    0.4138
+    0.4448
     """
     if residuals.size == 0:
         return 0.0
     centred = np.array(residuals, dtype=np.float64)  # one copy, reordered by the in-place medians
     centred -= np.median(centred, overwrite_input=True)
     spread = np.abs(centred)
-    scale = MAD_TO_SD * float(np.median(spread, overwrite_input=True))
-    if scale > 0:
-        return scale
-    step = float(np.min(np.abs(centred[centred != 0]), initial=np.inf))  # the smallest quantization step
-    scale = float(np.sqrt(np.mean(centred * centred)))
-    for _ in range(MAX_PASSES):
-        inside = centred[np.abs(centred) <= max(3.0 * scale, step)]
-        clipped = float(np.sqrt(np.mean(inside * inside)))
-        if clipped == scale:
-            break
-        scale = clipped
-    return scale / CLIPPED_SD
+    mad = float(np.median(spread, overwrite_input=True))
+    if mad > 0 and np.count_nonzero(spread == mad) <= GROUPED_TIES * spread.size:
+        return MAD_TO_SD * mad
+    return grouped_iqr_scale(centred)
+
+
+def grouped_iqr_scale(values: np.ndarray) -> float:
+    """(Q3 - Q1) / 1.349 of quantized ``values``, each spread uniformly over its bin.
+
+    The bin width h is the smallest gap between distinct values (gaps below
+    1e-9 of the range are rounding, merged); bins are centred on multiples
+    of h. A quartile falls in bin k of lower edge (k - 1/2) h, holding c_k
+    of the values with F below it: q_p = (k - 1/2) h + (p N - F) / c_k * h.
+
+    >>> round(grouped_iqr_scale(np.array([-1.0] * 25 + [0.0] * 950 + [1.0] * 25)), 4)
+    0.3902
+    """
+    distinct, counts = np.unique(values, return_counts=True)
+    span = float(distinct[-1] - distinct[0])
+    if span == 0:
+        return 0.0
+    gaps = np.diff(distinct)
+    step = float(gaps[gaps > 1e-9 * span].min())
+    bins = np.rint(np.clip(distinct / step, -2.0**62, 2.0**62)).astype(np.int64)
+    bins, where = np.unique(bins, return_inverse=True)
+    counts = np.bincount(where, weights=counts)
+    cumulative = np.cumsum(counts)
+    quartiles = []
+    for p in (0.25, 0.75):
+        target = p * cumulative[-1]
+        k = int(np.searchsorted(cumulative, target, side="right"))
+        k = min(k, bins.size - 1)
+        below = cumulative[k - 1] if k > 0 else 0.0
+        quartiles.append((bins[k] - 0.5 + (target - below) / counts[k]) * step)
+    return float(quartiles[1] - quartiles[0]) / IQR_TO_SD
 
 
 def _every_kth(values: np.ndarray) -> np.ndarray:
