@@ -229,8 +229,9 @@ def test_consistent_on_clean_gaussian_data(process):
     # relative standard error of the "mo" AV: about sqrt(2 m / N) (white), sqrt(3 m / N) (random walk)
     bound = 4 * np.sqrt(3 * m / n)
     assert np.all(np.abs(res.allan[useful] / theory[useful] - 1) < bound[useful])
-    assert res.outliers.count <= 2  # a Gaussian sample beyond 5 sd: probability 6e-7
-    np.testing.assert_allclose(res.allan, ordinary.allan, rtol=1e-3)
+    assert res.outliers.count < 2e-4 * n  # a Gaussian residual beyond 4 sd: probability 6.3e-5 (17 expected)
+    # the few clean extremes set aside move each level by < 0.2 %, or by < 10 % of its standard error (2 errors)
+    assert np.all(np.abs(res.allan / ordinary.allan - 1) < np.maximum(2e-3, 0.1 * 2 * ordinary.errors))
 
 
 @pytest.mark.parametrize("seed", [0, 1])
