@@ -23,14 +23,24 @@ without the spikes, level by level, over seeds (median and largest |ratio - 1|):
 * clean data: ``robust`` and ``ordinary`` on the series without spikes
   against the closed form AV (Fisher consistency and the spread across seeds).
 
+Spike sizes: the worst |ratio - 1| over the levels with N / 2m >= 100, for
+5 % spikes of 6 to 20 sigma, at thresholds 4 (the default) and 5.
+
+Real logs (optional: ``--realdata DIR`` or the environment variable
+``AVAR_REALDATA``, a folder of ``.npz`` files holding ``data`` (N, C) and
+``columns``): per channel, ``count_outliers`` at 6 robust SD and the range of
+robust / ordinary AV. Only numbers are printed; the logs stay where they are.
+
 Usage::
 
-    PYTHONPATH=src nice python benchmarks/bench_robust.py [--seeds 20] [--n 131072]
+    PYTHONPATH=src:benchmarks nice python benchmarks/bench_robust.py [--seeds 20] [--n 131072] [--realdata DIR]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+from pathlib import Path
 
 import numpy as np
 from scipy import integrate, optimize
@@ -140,14 +150,50 @@ def accuracy(n: int, seeds: int) -> None:
         print(f"{'':>9}  sd   " + " ".join(f"{v:.3f}" for v in values.std(axis=0)))
 
 
+def spike_sizes(n: int, seeds: int) -> None:
+    factors = avar.avar(np.arange(n, dtype=float)).averaging_factors
+    useful = n / (2 * factors) >= 100
+    print("\nspike size: worst |AV / clean AV - 1| over the * levels, 5 % spikes")
+    for size in (6.0, 8.0, 12.0, 20.0):
+        cells = []
+        for threshold in (4.0, 5.0):
+            worst = 0.0
+            for seed in range(seeds):
+                rng = np.random.default_rng(2000 + seed)
+                clean = white_plus_walk(n, rng)
+                spiky = with_spikes(clean, rng, size=size)
+                ratio = avar.robust_avar(spiky, threshold=threshold).allan / avar.avar(clean).allan
+                worst = max(worst, float(np.abs(ratio[useful] - 1).max()))
+            cells.append(f"threshold {threshold:g}: {worst:.3f}")
+        print(f"  {size:4.0f} sigma: " + ", ".join(cells))
+
+
+def real_logs(folder: Path) -> None:
+    print(f"\nreal logs in {folder}: outliers at 6 robust SD, and robust / ordinary AV (min, max) per channel")
+    for path in sorted(folder.glob("*.npz")):
+        archive = np.load(path)
+        data, columns = archive["data"], archive["columns"]
+        for j, column in enumerate(columns):
+            x = np.asarray(data[:, j], dtype=np.float64)
+            found = avar.count_outliers(x)
+            ratio = avar.robust_avar(x).allan / avar.avar(x).allan
+            print(f"  {path.name} {column}: {found.count} outliers ({100 * found.fraction:.3f} %), "
+                  f"robust / ordinary {ratio.min():.4f} .. {ratio.max():.4f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--n", type=int, default=2**17, help="length of the accuracy simulations")
     parser.add_argument("--speed-n", type=int, default=1_440_000)
+    parser.add_argument("--realdata", default=os.environ.get("AVAR_REALDATA"),
+                        help="folder of real .npz logs (default: $AVAR_REALDATA; skipped when absent)")
     args = parser.parse_args()
     speed(args.speed_n)
     accuracy(args.n, args.seeds)
+    spike_sizes(args.n, max(1, args.seeds // 4))
+    if args.realdata and Path(args.realdata).is_dir():
+        real_logs(Path(args.realdata))
 
 
 if __name__ == "__main__":

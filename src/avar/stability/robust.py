@@ -258,8 +258,8 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
       excess is subtracted.
 
     A level is ``intact`` when its relative sampling error, about
-    sqrt(2 m / C) for C intact differences, is at most the fill's bias bound
-    1.5 p; otherwise it is filled. With no sample flagged the result is
+    sqrt(2 m / C) for C intact differences, is at most the uncorrected
+    fill's bias bound 1.5 p; otherwise it is filled. With no sample flagged the result is
     ``avar.avar(x, type="mo")`` exactly.
 
     Why not a robust scale of the differences: the Haar wavelet coefficients
@@ -272,7 +272,8 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
     m = 8. In simulations (white noise + random walk, 5 % spikes of 20
     sigma; ``benchmarks/bench_robust.py``) such an estimator is within 1 %
     at m = 2, 30 % high at m = 4 and 20x high beyond, while this one is
-    within 8 % at every level. The result's ``contaminated`` gives 1 - C /
+    within 5 % at every level with N / 2m >= 100 (median within 0.5 %),
+    and on the series without spikes its spread equals the ordinary one. The result's ``contaminated`` gives 1 - C /
     (N - 2m + 1) per level, the breakdown measure of a coefficient-domain
     estimator.
 
@@ -284,8 +285,9 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
     proportional to 1 / m**2, a "blue" noise whose cluster sums telescope)
     an interpolated sample breaks the telescoping, and a filled level is
     raised by about p s**2 / m, which dominates at large m (with 5 % spikes
-    on pure quantization noise, 3.3x at m = 32 and more beyond). Real sensors have white
-    noise above quantization noise beyond the shortest taus.
+    on pure quantization noise, 3.3x at m = 32 and more beyond). Real
+    sensors have white noise above quantization noise beyond the shortest
+    taus.
 
     Parameters
     ----------

@@ -73,7 +73,8 @@ class RobustAllanVariance(AllanVariance):
         Per level: True where the level averages only the differences whose
         2m samples hold no flagged sample (unbiased for the clean process),
         False where it is the ordinary estimator of the series with the
-        flagged samples replaced by linear interpolation.
+        flagged samples replaced by linear interpolation, less white
+        noise's interpolation excess (see :func:`avar.robust_avar`).
     contaminated : ndarray
         Per level, the fraction of the N - 2m + 1 differences that touch a
         flagged sample, about 1 - (1 - p)**(2m) ~= 2 m p for a flagged
