@@ -41,6 +41,7 @@ _EXPORTS = {
     "robust_avar": "avar.stability.robust",
     "count_outliers": "avar.stability.robust",
     "RobustAllanVariance": "avar.stability.robust_results",
+    "Outliers": "avar.stability.robust_results",
     "adev": "avar.stability.deviations",
     "oadev": "avar.stability.deviations",
     "mdev": "avar.stability.deviations",

@@ -200,7 +200,8 @@ def test_intact_and_filled_levels_match_plain_loops():
     filled = spiky.copy()
     filled[bad] = np.interp(where, np.flatnonzero(keep), spiky[keep])
     assert res.intact[0] and not res.intact[-1]
-    for j, m in enumerate(res.averaging_factors[:80]):
+    for j in [*range(25), *range(len(res) - 3, len(res))]:  # the intact levels, filled ones, the largest
+        m = res.averaging_factors[j]
         if res.intact[j]:
             expected = mo_loop(spiky, m, bad)
         else:  # less the white noise's fill excess p s**2 / m, at most a share 1.5 p / (1 + 1.5 p)
@@ -265,6 +266,22 @@ def test_the_fill_excess_of_white_noise_is_removed():
     assert res.outliers.scale == pytest.approx(np.sqrt(1.5), rel=0.02)
     ratio = (res.allan / avar.avar(clean).allan)[filled]
     assert abs(np.mean(ratio) - 1) < 0.025 and np.all(np.abs(ratio - 1) < 0.06), ratio
+
+
+def test_results_are_read_only_and_checked():
+    res = avar.robust_avar(add_spikes(white_plus_walk(2000, 1), 0.02, 20.0, 2)[0])
+    for name in ("allan", "intact", "contaminated"):
+        with pytest.raises(ValueError):
+            getattr(res, name)[0] = 1
+    with pytest.raises(ValueError):
+        res.outliers.indices[0] = 0
+    fields = {f: getattr(res, f) for f in ("levels", "averaging_factors", "allan", "errors", "n_differences")}
+    with pytest.raises(TypeError, match="outliers must be"):
+        avar.RobustAllanVariance(**fields, type="mo", freq=1.0, n=2000, intact=res.intact,
+                                 contaminated=res.contaminated)
+    with pytest.raises(ValueError, match="one value per level"):
+        avar.RobustAllanVariance(**fields, type="mo", freq=1.0, n=2000, outliers=res.outliers,
+                                 intact=res.intact[:-1], contaminated=res.contaminated)
 
 
 def test_levels_follow_avar_grids():
