@@ -361,3 +361,16 @@ def test_huge_and_tiny_magnitudes_scale_exactly():
         np.testing.assert_allclose(res.allan, base.allan * factor**2, rtol=1e-12)
     with pytest.raises(ValueError, match="overflows float64"):
         avar.robust_avar(spiky * 1e306)
+
+
+def test_resists_spikes_on_quantized_data():
+    """LSB of half the white noise's sigma: the grouped robust scale; no clean sample counted at 6 SD."""
+    n = 2**17
+    clean = np.round(white_plus_walk(n, 4) / 0.5) * 0.5
+    spiky, where = add_spikes(clean, 0.05, 20.0, seed=5)
+    assert avar.count_outliers(clean).count == 0
+    res = avar.robust_avar(spiky)
+    assert abs(res.outliers.count - where.size) <= 0.005 * where.size
+    reference = avar.avar(clean)
+    useful = n / (2 * res.averaging_factors) >= 100
+    assert np.all(np.abs(res.allan / reference.allan - 1)[useful] < 0.10)
