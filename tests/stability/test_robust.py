@@ -310,6 +310,12 @@ def test_validation_of_the_series():
         avar.count_outliers(np.zeros((10, 2)))
     with pytest.raises(ValueError, match="x"):
         avar.robust_avar(np.array([1.0, np.nan, 2.0, 3.0]))
+    imu = avar.IMU(np.zeros((100, 6)), freq=10.0, gyro=[0, 1, 2], accel=[3, 4, 5])
+    for table in (imu, pd.DataFrame({"a": np.arange(10.0)})):
+        with pytest.raises(TypeError, match="x must be one series"):
+            avar.robust_avar(table)
+        with pytest.raises(TypeError, match="x must be one series"):
+            avar.count_outliers(table)
 
 
 def release_loop(x: np.ndarray, flagged: np.ndarray, limit: float) -> np.ndarray:

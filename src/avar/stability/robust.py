@@ -9,12 +9,14 @@ the wavelet coefficients down-weighted).
 
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 import numpy as np
 
 from avar import _kernels
 from avar._validation import as_series, check_real
+from avar.imu import IMU
 from avar.stability.columns import allan_variance_columns
 from avar.stability.grids import averaging_factors, n_differences
 from avar.stability.intervals import relative_errors
@@ -132,6 +134,16 @@ def flag_outliers(values: np.ndarray, threshold: float) -> Outliers:
     return Outliers(count=int(indices.size), indices=indices, n=n, threshold=threshold, scale=scale)
 
 
+def _series(x: Any, freq: Any) -> tuple[np.ndarray, float]:
+    """Validated contiguous float64 values and rate of one series (an IMU or a table is refused by name)."""
+    pd = sys.modules.get("pandas")  # not loaded: x cannot be a pandas object
+    if isinstance(x, IMU) or (pd is not None and isinstance(x, pd.DataFrame)):
+        raise TypeError(f"x must be one series, got {'an avar.IMU' if isinstance(x, IMU) else 'a DataFrame'}; "
+                        "give its channels one at a time, e.g. x=imu.data[:, j] with freq=imu.freq")
+    values, rate = as_series(x, freq)
+    return np.ascontiguousarray(values, dtype=np.float64), rate
+
+
 def _check_threshold(threshold: Any) -> float:
     threshold = check_real(threshold, "threshold")
     if not threshold > 0:
@@ -198,8 +210,7 @@ def count_outliers(x: Any, threshold: float = 6.0) -> Outliers:
     (4, [100, 101, 5000, 7001])
     """
     threshold = _check_threshold(threshold)
-    values, _ = as_series(x, None)
-    return flag_outliers(np.ascontiguousarray(values, dtype=np.float64), threshold)
+    return flag_outliers(_series(x, None)[0], threshold)
 
 
 def intact_counts(flagged: np.ndarray, n: int, factors: np.ndarray) -> np.ndarray:
@@ -338,8 +349,7 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
     (True, True)
     """
     threshold = _check_threshold(threshold)
-    values, rate = as_series(x, freq)
-    values = np.ascontiguousarray(values, dtype=np.float64)
+    values, rate = _series(x, freq)
     n = values.size
     factors = averaging_factors(n, rate, taus)
     outliers = flag_outliers(values, threshold)
