@@ -17,6 +17,7 @@ tests check every kernel against a plain NumPy transcription.
   all on the primitives of :mod:`avar._kernels.streaming`.
 * :mod:`avar._kernels.covariance`: the theoretical Allan variance of a
   covariance matrix (one validating pass, then O(n) per scale).
+* :mod:`avar._kernels.robust`: residuals from interpolation and the running median (outliers).
 * :mod:`avar._kernels.simulation`: recursions of the simulated processes.
 """
 
@@ -43,4 +44,10 @@ from avar._kernels.allan import (  # noqa: E402
 )
 from avar._kernels.columns import allan_variance_columns as streaming_allan_variance  # noqa: E402
 from avar._kernels.covariance import COV_TILE, NOAV_SCAN_RATIO, covariance_pass, moav_from_sums  # noqa: E402
+from avar._kernels.robust import (  # noqa: E402
+    intact_squares,
+    interpolation_residuals,
+    release_candidates,
+    running_median,
+)
 from avar._kernels.simulation import ar1_recursion  # noqa: E402

@@ -7,6 +7,7 @@
 * :mod:`avar.stability.intervals`: confidence intervals (R's, chi-squared);
 * :mod:`avar.stability.edf`: Greenhall's EDF, chi-squared bounds;
 * :mod:`avar.stability.noise_id`: power-law noise identification;
+* :mod:`avar.stability.robust`: outliers and the robust Allan variance;
 * :mod:`avar.stability.results`: :class:`AllanVariance`, :class:`ImuAllanVariance`.
 """
 
