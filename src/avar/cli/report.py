@@ -1,13 +1,14 @@
 """``avar report``: the IMU noise report of a log in one command.
 
 Reads the file, runs :func:`avar.noise_report` (no scales to choose), writes
-the requested files (Kalibr ``imu.yaml``, figure, CSV table) and then prints
+the requested files (Kalibr ``imu.yaml``, figure, CSV table, HTML page) and then prints
 the table, by the output rules of :mod:`avar.cli.outputs`.
 """
 
 from __future__ import annotations
 
 import argparse
+import shlex
 import sys
 from pathlib import Path
 from types import SimpleNamespace
@@ -46,9 +47,13 @@ def run(args: argparse.Namespace) -> int:
     inputs = [Path(args.file)]
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
     kalibr = check_output_path("--kalibr", args.kalibr, inputs, args.force) if args.kalibr else None
-    if kalibr is not None and any(isinstance(p, Path) and p.resolve() == kalibr.resolve()
-                                  for p in (plan.csv, plan.figure)):
-        raise UsageError(f"--kalibr {args.kalibr!r} is also given for another output; give them different names")
+    page = check_output_path("--html", args.html, inputs, args.force) if args.html is not None else None
+    taken = [p.resolve() for p in (plan.csv, plan.figure) if isinstance(p, Path)]
+    for option, text, path in (("--kalibr", args.kalibr, kalibr), ("--html", args.html, page)):
+        if path is not None and path.resolve() in taken:
+            raise UsageError(f"{option} {text!r} is also given for another output; give them different names")
+        if path is not None:
+            taken.append(path.resolve())
     progress = Progress()
     progress(f"reading {args.file}")
     recording = read_recording(args)
@@ -64,6 +69,12 @@ def run(args: argparse.Namespace) -> int:
         text = yaml.safe_dump(report.kalibr(), sort_keys=False, default_flow_style=False)
         write_atomically(kalibr, text.encode("utf-8"))
         files.append(str(kalibr))
+    if page is not None:
+        from avar.plotting.html_report import report_html
+
+        command = " ".join(shlex.quote(word) for word in getattr(args, "command_line", None) or sys.argv)
+        write_atomically(page, report_html(report, command=command, source=str(args.file)).encode("utf-8"))
+        files.append(str(page))
     written = plan.write(csv=lambda: report.table.to_csv(index=False), figure=report.plot)
     progress("done")
     print_outputs(Written(tuple(files) + written.files, written.stdout_csv), str(report))
@@ -89,6 +100,8 @@ def add_parser(commands) -> None:
     report.add_argument("--alpha", type=float, default=0.05, help="1 - confidence level of the intervals")
     report.add_argument("--kalibr", metavar="YAML", help="write a Kalibr imu.yaml")
     report.add_argument("--plot", metavar="PNG", help="write the report figure")
+    report.add_argument("--html", metavar="HTML", help="write the report as one self-contained HTML page "
+                        "(inline SVG figures, tables, warnings, command, version)")
     report.add_argument("--output", metavar="CSV", help="write the table of terms")
     report.add_argument("--force", action="store_true", help="overwrite existing output files")
     report.set_defaults(handler=run)
