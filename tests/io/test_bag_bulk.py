@@ -188,3 +188,80 @@ def test_cli_gives_one_line_and_exit_1_for_a_random_bag(tmp_path):
     assert out.returncode == 1
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and str(noise) in lines[0] and "Traceback" not in out.stderr, out.stderr
+
+
+def sql_reference(path, topic):
+    """The same rows by plain SQL, as rosbags queries them (timestamp order, ties by row)."""
+    import sqlite3
+
+    with sqlite3.connect(path) as db:
+        (tid,) = db.execute("SELECT id FROM topics WHERE name=?", (topic,)).fetchone()
+        return db.execute("SELECT timestamp, data FROM messages WHERE topic_id=? ORDER BY timestamp, id",
+                          (tid,)).fetchall()
+
+
+def test_sqlite_btree_reader_equals_sql_on_a_two_level_tree(tmp_path, monkeypatch):
+    from avar.io import bag_sqlite
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    n = 6000  # about 500 leaf pages of 4 KiB: the root's children are interior pages
+    values, stamps, _ = mixed(n, seed=4)
+    stamps[100:110] = stamps[100]  # equal receive times keep their row order
+    with Writer2(tmp_path / "big", version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
+        a = writer.add_connection("/imu", "sensor_msgs/msg/Imu", typestore=store)
+        s = writer.add_connection("/s", "std_msgs/msg/String", typestore=store)
+        for i in range(n):
+            writer.write(a, int(stamps[i]), bytes(store.serialize_cdr(imu(store, values[i], stamps[i], "f" * (i % 9)),
+                                                                      "sensor_msgs/msg/Imu")))
+            if i % 3 == 0:
+                writer.write(s, int(stamps[i]), bytes(store.serialize_cdr(
+                    store.types["std_msgs/msg/String"](data="y" * (i % 50)), "std_msgs/msg/String")))
+    path = next((tmp_path / "big").glob("*.db3"))
+    data = path.read_bytes()
+    page = int.from_bytes(data[16:18], "big")
+    import sqlite3
+
+    with sqlite3.connect(path) as db:
+        root = bag_sqlite.check_schema(db)
+    first_child = int.from_bytes(data[(root - 1) * page + 12 + 0:(root - 1) * page + 14], "big")
+    child = int.from_bytes(data[(root - 1) * page + first_child:(root - 1) * page + first_child + 4], "big")
+    assert data[(root - 1) * page] == 0x05 and data[(child - 1) * page] == 0x05  # two interior levels
+    rows = sql_reference(path, "/imu")
+    used = []
+    original = bag_sqlite.read_messages
+    monkeypatch.setattr(bag_sqlite, "read_messages", lambda *a: used.append(1) or original(*a))
+    name, got, got_stamps, received = bags.read_messages(path, "/imu")
+    assert used == [1]
+    assert received.tolist() == [r[0] for r in rows]
+    want = [reference(r[1], cdr=True) for r in rows]
+    assert got.tolist() == [list(w[0]) for w in want]
+    assert got_stamps.tolist() == [w[1] for w in want]
+
+
+def test_sqlite_rows_on_overflow_pages_fall_back_to_sql(tmp_path, monkeypatch):
+    from avar.io import bag_sqlite
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    values, stamps, _ = mixed(20, seed=6)
+    with Writer2(tmp_path / "long", version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
+        a = writer.add_connection("/imu", "sensor_msgs/msg/Imu", typestore=store)
+        for i in range(20):
+            frame = "z" * (6000 if i == 7 else 3)  # one message larger than a page
+            writer.write(a, int(stamps[i]), bytes(store.serialize_cdr(imu(store, values[i], stamps[i], frame),
+                                                                      "sensor_msgs/msg/Imu")))
+    path = next((tmp_path / "long").glob("*.db3"))
+    refused = []
+    original = bag_sqlite.read_messages
+
+    def spy(*args):
+        try:
+            return original(*args)
+        except bag_sqlite.Untrusted as error:
+            refused.append(str(error))
+            raise
+
+    monkeypatch.setattr(bag_sqlite, "read_messages", spy)
+    got = bags.read_messages(path, "/imu")
+    assert refused == ["overflow"]
+    np.testing.assert_array_equal(got[1], values)
+    np.testing.assert_array_equal(got[2], stamps)

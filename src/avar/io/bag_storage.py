@@ -13,7 +13,8 @@ compression, an unindexed file, records not where the index says) raises
   offset) is read with NumPy, and the chunk is decompressed once.
 * ``.mcap``: ``rosbags``' reader gives the chunk index; each chunk's message index
   (16 bytes per message: log time and offset) is read with NumPy.
-* ``.db3``: one SQL query on the ``messages`` table in row order.
+* ``.db3``: the ``messages`` table's B-tree read from the file with NumPy
+  (:mod:`avar.io.bag_sqlite`), else one SQL query in row order.
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from avar.io.bag_decode import words
+
 BATCH_BYTES = 32 << 20  # decompressed chunks decoded together
 
 
@@ -35,7 +38,7 @@ class Untrusted(Exception):
 
 def _u32(buf: np.ndarray, pos: np.ndarray) -> np.ndarray:
     """The little-endian uint32 at each position, as int64."""
-    return buf[pos[:, None] + np.arange(4)].view("<u4").reshape(len(pos)).astype(np.int64)
+    return words(buf, "<u4")[pos].astype(np.int64)
 
 
 def _mapped(bio) -> np.ndarray:
@@ -99,6 +102,9 @@ class Ros1Bag:
         """Start and length of the data of the message records at ``pos`` (checked against the index)."""
         from rosbags.rosbag1.reader import Header
 
+        if np.any(np.diff(pos) < 0):  # file order: (chunk, offset), as rosbags sorts its index
+            order = np.argsort(pos, kind="stable")
+            pos, conn, times = pos[order], conn[order], times[order]
         head = _u32(buf, pos)
         if len(pos) == 0 or np.any(head != head[0]) or int(pos.max() + 8 + head[0]) > len(buf):
             raise Untrusted("record headers differ")
@@ -204,6 +210,9 @@ class McapBag:
 
     @staticmethod
     def _records(buf, start, times):
+        if np.any(np.diff(start) < 0):  # file order within the chunk, as rosbags reads it
+            order = np.argsort(start, kind="stable")
+            start, times = start[order], times[order]
         lengths = _u32(buf, start + 1) | (_u32(buf, start + 5) << 32)
         if np.any(buf[start] != 0x05) or np.any(lengths < 22):
             raise Untrusted("not message records")
@@ -232,6 +241,18 @@ class Db3Bag:
         self._db.close()
 
     def batches(self, ids: set[int]):
+        from avar.io import bag_sqlite
+
+        try:
+            root = bag_sqlite.check_schema(self._db)
+            (page,) = self._db.execute("PRAGMA page_size").fetchone()
+            with self.path.open("rb") as bio:
+                buf = _mapped(bio)
+            starts, lengths, times = bag_sqlite.read_messages(buf, root, int(page), int(buf[20]), ids)
+            yield buf, starts, lengths, times
+            return
+        except bag_sqlite.Untrusted:
+            pass
         marks = ",".join("?" * len(ids))
         rows = self._db.execute(f"SELECT timestamp, data FROM messages WHERE topic_id IN ({marks}) ORDER BY id",
                                 sorted(ids)).fetchall()

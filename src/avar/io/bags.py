@@ -107,9 +107,6 @@ def _bulk(path: Path, topic: str | None, progress: bool):
 
                 batches = tqdm(batches, desc=f"reading {path.name}", unit="batch", file=sys.stderr, leave=False)
             for buf, starts, lengths, received in batches:
-                if np.any(np.diff(starts) < 0):  # file order within a batch
-                    order = np.argsort(starts, kind="stable")
-                    starts, lengths, received = starts[order], lengths[order], received[order]
                 decoded = decode_imu(buf, starts, lengths, cdr=not isinstance(storage, Ros1Bag))
                 if decoded is None:
                     raise Untrusted("layout")
