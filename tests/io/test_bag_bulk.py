@@ -265,3 +265,14 @@ def test_sqlite_rows_on_overflow_pages_fall_back_to_sql(tmp_path, monkeypatch):
     assert refused == ["overflow"]
     np.testing.assert_array_equal(got[1], values)
     np.testing.assert_array_equal(got[2], stamps)
+
+
+@pytest.mark.parametrize("kind", ["bag", "db3", "mcap"])
+def test_an_untrusted_layout_falls_back_to_rosbags_with_the_same_values(tmp_path, kind, monkeypatch):
+    path, values, stamps = write(kind, tmp_path, n=50)
+    assert bags.imu_topics(path) == ["/imu/data", "/imu/other"]
+    monkeypatch.setattr(bags, "decode_imu", lambda *a, **k: None)  # as for a layout the decoder refuses
+    name, got, got_stamps, received = bags.read_messages(path, "/imu/data")
+    np.testing.assert_array_equal(got, values)
+    np.testing.assert_array_equal(got_stamps, stamps)
+    np.testing.assert_array_equal(received, stamps + 7)

@@ -39,6 +39,11 @@ def words(buf: np.ndarray, dtype: str) -> np.ndarray:
 
     ``words(buf, "<f8")[positions]`` gathers unaligned float64 at arbitrary offsets in one
     indexing operation (overlapping windows, no copy of ``buf``).
+
+    >>> import numpy as np
+    >>> buf = np.frombuffer(bytes([0, 1, 0, 0, 0, 2]), np.uint8)
+    >>> words(buf, "<u4")[[1]].tolist(), words(buf, ">u2")[[4]].tolist()
+    ([1], [2])
     """
     dt = np.dtype(dtype)
     if len(buf) < dt.itemsize:

@@ -83,8 +83,15 @@ def _choose_topic(connections: list[tuple], path: Path, topic: str | None) -> st
 
 def imu_topics(path: str | Path) -> list[str]:
     """The ``sensor_msgs/msg/Imu`` topics of a bag, sorted."""
-    with _reader(Path(path)) as reader:
-        return sorted({c.topic for c in reader.connections if c.msgtype == IMU_TYPE})
+    path = Path(path)
+    try:
+        storages = [STORAGES[file.suffix.lower()](file) for file in _files(path)]
+    except (Untrusted, KeyError):
+        with _reader(path) as reader:
+            return sorted({c.topic for c in reader.connections if c.msgtype == IMU_TYPE})
+    for storage in storages:
+        storage.close()
+    return sorted({c[1] for s in storages for c in s.connections if c[2] == IMU_TYPE})
 
 
 def _bulk(path: Path, topic: str | None, progress: bool):
