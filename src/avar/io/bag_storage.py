@@ -20,6 +20,7 @@ compression, an unindexed file, records not where the index says) raises
 from __future__ import annotations
 
 import mmap
+import os
 import sqlite3
 import struct
 from io import BytesIO
@@ -42,8 +43,14 @@ def _u32(buf: np.ndarray, pos: np.ndarray) -> np.ndarray:
 
 
 def _mapped(bio) -> np.ndarray:
-    """The whole file as a read-only uint8 array (no copy; pages are read as touched)."""
-    flags = mmap.MAP_SHARED | getattr(mmap, "MAP_POPULATE", 0)  # pages read ahead by the kernel
+    """The whole file as a read-only uint8 array (no copy; pages are read as touched).
+
+    Files up to 4 GiB are read ahead by the kernel in one go (``MAP_POPULATE``), which
+    is much faster than faulting their pages in one by one; larger ones are left to
+    demand paging so as not to crowd the page cache.
+    """
+    size = os.fstat(bio.fileno()).st_size
+    flags = mmap.MAP_SHARED | (getattr(mmap, "MAP_POPULATE", 0) if size <= 4 << 30 else 0)
     return np.frombuffer(mmap.mmap(bio.fileno(), 0, flags=flags, prot=mmap.PROT_READ), np.uint8)
 
 
