@@ -137,6 +137,19 @@ def write_bags(folder: Path, hours: float, seed: int = 0) -> dict[str, Path]:
     return paths
 
 
+def same_values(paths: dict[str, Path]) -> str:
+    """Whether every bag gives exactly the CSV's numbers (read once, in this process, untimed)."""
+    sys.path.insert(0, SRC)
+    import avar
+
+    table = avar.read(paths["CSV"])
+    csv = np.column_stack([np.asarray(table[name]) for name in CHANNELS])
+    verdicts = []
+    for kind in (".bag", ".db3", ".mcap"):
+        verdicts.append(f"{kind} {'yes' if np.array_equal(avar.read(paths[kind]).data, csv) else 'NO'}")
+    return ", ".join(verdicts)
+
+
 def bench_bags(args, env: dict) -> None:
     """avar.read of the same data as CSV and as each bag format; ratios bag / CSV."""
     python = sys.executable
@@ -154,6 +167,7 @@ def bench_bags(args, env: dict) -> None:
                 best[name] = (wall, rss)
     floor = best["avar.read CSV"][0]
     print(f"{args.bags:g} h at {RATE:g} Hz, 6 channels ({n} messages); best of {args.repeat[0]}")
+    print("values identical to the CSV's:", same_values(paths))
     print(f"{'case':28s} {'wall s':>8s} {'/ CSV':>7s} {'peak RSS MB':>12s}")
     for name, (wall, rss) in best.items():
         print(f"{name:28s} {wall:8.2f} {wall / floor:7.2f} {rss:12.0f}")
