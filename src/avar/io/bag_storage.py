@@ -67,7 +67,7 @@ class Ros1Bag:
         magic = bio.readline(64)
         if not magic.startswith(b"#ROSBAG V2.0"):
             bio.close()
-            raise ValueError(f"{path}: not a ROS 1 bag (no '#ROSBAG V2.0' line at its start)")
+            raise Untrusted("no '#ROSBAG V2.0' line at its start")
         header = Header.read(bio, RecordType.BAGHEADER)
         index_pos, conn_count = header.get_uint64("index_pos"), header.get_uint32("conn_count")
         chunk_count = header.get_uint32("chunk_count")

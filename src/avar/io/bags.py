@@ -157,15 +157,19 @@ def read_messages(path: str | Path, topic: str | None = None, progress: bool | N
                   bulk: bool = True) -> tuple[str, np.ndarray, np.ndarray, np.ndarray]:
     """Topic name, values (n, 6), header stamps and receive times (ns) of a bag's Imu topic.
 
-    ``bulk=False`` forces the message-by-message path. Any failure of the bag library
-    or of the file's structure becomes a :class:`BagError` naming the file.
+    ``bulk=False`` forces the message-by-message path; the bulk path also hands over to
+    it whenever it meets anything it does not know (so a newer ``rosbags`` or an odd
+    file costs speed, not correctness). A failure of the bag library or of the file's
+    structure then becomes a :class:`BagError` naming the file.
     """
     path = Path(path)
     try:
         if bulk:
             try:
                 return _bulk(path, topic, progress_enabled(progress, 0))
-            except Untrusted:
+            except (BagError, ImportError, MemoryError):
+                raise
+            except Exception:  # Untrusted, or a structure (or rosbags version) the bulk reader does not know
                 pass
         return _per_message(path, topic, progress)
     except (BagError, ImportError, MemoryError):
