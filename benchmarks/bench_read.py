@@ -11,16 +11,25 @@ times, each in a fresh subprocess, with its peak resident memory (``os.wait4``):
   octave grid (the usual script a user would write).
 
 Ratios are to ``read_csv`` of the same file in the same run; the machine's load shows in all
-three alike. Usage::
+three alike.
+
+``--bags HOURS`` (e.g. 2) writes the same 200 Hz 6-axis data as a CSV (time column and six
+channels) and as ``sensor_msgs/Imu`` topics of a ROS 1 ``.bag``, a ROS 2 ``.db3`` and an
+``.mcap`` (with ``rosbags``' writers, messages serialized from a template with NumPy), then
+times ``avar.read`` of each in a fresh subprocess and prints the ratio bag / CSV (target:
+at most 1.5). ``--per-message`` adds rosbags' message-by-message decoding for comparison.
+Usage::
 
     python benchmarks/bench_read.py                 # 1 h and 8 h, best of 3 and 1 runs
     python benchmarks/bench_read.py --hours 1 --repeat 5
+    python benchmarks/bench_read.py --bags 2 --repeat 3
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -61,6 +70,109 @@ def write_log(path: Path, hours: float, seed: int = 0) -> Path:
     return path
 
 
+READ = "import sys, avar; x = avar.read(sys.argv[1]); assert x.n == int(sys.argv[2]), x.n"
+READ_SLOW = ("import sys\nfrom avar.io.bags import read_messages\n"
+             "assert len(read_messages(sys.argv[1], bulk=False)[1]) == int(sys.argv[2])")
+
+
+def _imu_bytes(store, ros1: bool, values: np.ndarray, stamps: np.ndarray) -> np.ndarray:
+    """Serialized Imu messages (n, size): one template from rosbags, the fields filled with NumPy."""
+    t = store.types
+    time = t["builtin_interfaces/msg/Time"](sec=0, nanosec=0)
+    header = t["std_msgs/msg/Header"]
+    head = header(seq=0, stamp=time, frame_id="imu_link") if ros1 else header(stamp=time, frame_id="imu_link")
+    vec = t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
+    msg = t["sensor_msgs/msg/Imu"](header=head, orientation=t["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+                                   orientation_covariance=np.zeros(9), angular_velocity=vec,
+                                   angular_velocity_covariance=np.zeros(9), linear_acceleration=vec,
+                                   linear_acceleration_covariance=np.zeros(9))
+    raw = bytes(store.serialize_ros1(msg, "sensor_msgs/msg/Imu") if ros1
+                else store.serialize_cdr(msg, "sensor_msgs/msg/Imu", little_endian=True))
+    n = len(values)
+    rows = np.tile(np.frombuffer(raw, np.uint8), (n, 1))
+    first = 16 + 8 if ros1 else 4 + (12 + 9 + 7) // 8 * 8  # frame_id "imu_link" (+ NUL in CDR)
+    for at, column in ((4, stamps // 10**9), (8, stamps % 10**9)):
+        rows[:, at:at + 4] = column.astype("<u4").view(np.uint8).reshape(n, 4)
+    rows[:, first + 104:first + 128] = values[:, :3].astype("<f8").view(np.uint8).reshape(n, 24)
+    rows[:, first + 200:first + 224] = values[:, 3:].astype("<f8").view(np.uint8).reshape(n, 24)
+    return rows
+
+
+def write_bags(folder: Path, hours: float, seed: int = 0) -> dict[str, Path]:
+    """The same log as CSV, ROS 1 .bag, ROS 2 .db3 and .mcap (written once, kept in ``folder``)."""
+    from rosbags.rosbag1 import Writer as Writer1
+    from rosbags.rosbag2 import StoragePlugin
+    from rosbags.rosbag2 import Writer as Writer2
+    from rosbags.typesys import Stores, get_typestore
+
+    n = int(hours * 3600 * RATE)
+    folder = folder / f"bags_{hours:g}h"
+    paths = {"CSV": folder / "imu.csv", ".bag": folder / "imu.bag", ".db3": folder / "db3" / "db3.db3",
+             ".mcap": folder / "mcap" / "mcap.mcap"}
+    if (folder / "rows").exists() and (folder / "rows").read_text() == str(n):
+        return paths
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir(parents=True)
+    rng = np.random.default_rng(seed)
+    values = rng.standard_normal((n, 6)) * 0.01 + [0, 0, 0, 0, 0, 9.81]
+    stamps = 1_700_000_000 * 10**9 + np.arange(n, dtype=np.int64) * round(1e9 / RATE)
+    table = np.column_stack([(stamps - stamps[0]) / 1e9, values])
+    with paths["CSV"].open("w") as out:
+        out.write("time," + ",".join(CHANNELS) + "\n")
+        np.savetxt(out, table, fmt=["%.3f"] + ["%.17g"] * 6, delimiter=",")
+    store = get_typestore(Stores.ROS1_NOETIC)
+    rows = _imu_bytes(store, True, values, stamps)
+    with Writer1(paths[".bag"]) as writer:
+        connection = writer.add_connection("/imu/data", "sensor_msgs/msg/Imu", typestore=store)
+        for i in range(n):
+            writer.write(connection, int(stamps[i]) + 1000, rows[i].tobytes())
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    rows = _imu_bytes(store, False, values, stamps)
+    for kind, plugin in ((".db3", StoragePlugin.SQLITE3), (".mcap", StoragePlugin.MCAP)):
+        with Writer2(paths[kind].parent, version=9, storage_plugin=plugin) as writer:
+            connection = writer.add_connection("/imu/data", "sensor_msgs/msg/Imu", typestore=store)
+            for i in range(n):
+                writer.write(connection, int(stamps[i]) + 1000, rows[i].tobytes())
+    (folder / "rows").write_text(str(n))
+    return paths
+
+
+def same_values(paths: dict[str, Path]) -> str:
+    """Whether every bag gives exactly the CSV's numbers (read once, in this process, untimed)."""
+    sys.path.insert(0, SRC)
+    import avar
+
+    table = avar.read(paths["CSV"])
+    csv = np.column_stack([np.asarray(table[name]) for name in CHANNELS])
+    verdicts = []
+    for kind in (".bag", ".db3", ".mcap"):
+        verdicts.append(f"{kind} {'yes' if np.array_equal(avar.read(paths[kind]).data, csv) else 'NO'}")
+    return ", ".join(verdicts)
+
+
+def bench_bags(args, env: dict) -> None:
+    """avar.read of the same data as CSV and as each bag format; ratios bag / CSV."""
+    python = sys.executable
+    paths = write_bags(args.dir, args.bags)
+    n = str(int(args.bags * 3600 * RATE))
+    cases = {f"avar.read {kind}": [python, "-c", READ, str(path), n] for kind, path in paths.items()}
+    if args.per_message:
+        cases.update({f"per-message {kind}": [python, "-c", READ_SLOW, str(path), n]
+                      for kind, path in paths.items() if kind != "CSV"})
+    best: dict[str, tuple[float, float]] = {}
+    for _ in range(args.repeat[0]):
+        for name, command in cases.items():
+            wall, rss, code = measure(command, env)
+            if code == 0 and (name not in best or wall < best[name][0]):
+                best[name] = (wall, rss)
+    floor = best["avar.read CSV"][0]
+    print(f"{args.bags:g} h at {RATE:g} Hz, 6 channels ({n} messages); best of {args.repeat[0]}")
+    print("values identical to the CSV's:", same_values(paths))
+    print(f"{'case':28s} {'wall s':>8s} {'/ CSV':>7s} {'peak RSS MB':>12s}")
+    for name, (wall, rss) in best.items():
+        print(f"{name:28s} {wall:8.2f} {wall / floor:7.2f} {rss:12.0f}")
+
+
 def measure(command: list[str], env: dict) -> tuple[float, float, int]:
     """Wall time (s), peak resident memory (MB) and exit status of one subprocess."""
     start = time.perf_counter()
@@ -81,9 +193,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, nargs="+", default=[3, 1], help="runs per file (best kept)")
     parser.add_argument("--dir", type=Path, default=Path(tempfile.gettempdir()) / "avar_bench_read")
     parser.add_argument("--no-allantools", action="store_true", help="skip the allantools script")
+    parser.add_argument("--bags", type=float, metavar="HOURS", help="compare avar.read of CSV and ROS bags")
+    parser.add_argument("--per-message", action="store_true", help="with --bags: also rosbags' per-message path")
     args = parser.parse_args(argv)
     args.dir.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""), MPLBACKEND="Agg")
+    if args.bags:
+        bench_bags(args, env)
+        return 0
     python = sys.executable
     rows = []
     for i, hours in enumerate(args.hours):

@@ -119,6 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     argv = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.command_line = ["avar", *argv]  # as given, for outputs that record how they were made
     repeated = _repeated_option(parser, args.command, argv)
     if repeated:
         print(f"avar {args.command}: error: {repeated} is given twice; give it once "

@@ -1,13 +1,14 @@
 """``avar report``: the IMU noise report of a log in one command.
 
 Reads the file, runs :func:`avar.noise_report` (no scales to choose), writes
-the requested files (Kalibr ``imu.yaml``, figure, CSV table) and then prints
+the requested files (Kalibr ``imu.yaml``, figure, CSV table, HTML page) and then prints
 the table, by the output rules of :mod:`avar.cli.outputs`.
 """
 
 from __future__ import annotations
 
 import argparse
+import shlex
 import sys
 from pathlib import Path
 from types import SimpleNamespace
@@ -47,8 +48,8 @@ def run(args: argparse.Namespace) -> int:
     inputs = [Path(args.file)]
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
     extra = {}
-    for option, value in (("--kalibr", args.kalibr), ("--curves", args.curves)):
-        if value:
+    for option, value in (("--kalibr", args.kalibr), ("--curves", args.curves), ("--html", args.html)):
+        if value is not None:
             extra[option] = check_output_path(option, value, inputs, args.force)
     taken = [p.resolve() for p in (plan.csv, plan.figure) if isinstance(p, Path)]
     for option, path in extra.items():
@@ -75,6 +76,11 @@ def run(args: argparse.Namespace) -> int:
     if "--curves" in extra:
         contents["--curves"] = report.curves.to_csv(index=False).encode("utf-8")
     files = []
+    if "--html" in extra:
+        from avar.plotting.html_report import report_html
+
+        command = " ".join(shlex.quote(word) for word in getattr(args, "command_line", None) or sys.argv)
+        contents["--html"] = report_html(report, command=command, source=str(args.file)).encode("utf-8")
     for option, data in contents.items():
         write_atomically(extra[option], data)
         files.append(str(extra[option]))
@@ -115,6 +121,8 @@ def add_parser(commands) -> None:
     report.add_argument("--customary-axis", action="store_true",
                         help="the figure's right axis in deg/h (gyroscopes) or ug (accelerometers)")
     report.add_argument("--plot", metavar="PNG", help="write the report figure")
+    report.add_argument("--html", metavar="HTML", help="write the report as one self-contained HTML page "
+                        "(inline SVG figures, tables, warnings, command, version)")
     report.add_argument("--output", metavar="CSV", help="write the table of terms")
     report.add_argument("--force", action="store_true", help="overwrite existing output files")
     report.set_defaults(handler=run)
