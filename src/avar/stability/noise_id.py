@@ -24,11 +24,10 @@ from avar.stability.deviation_grids import term_counts
 MIN_ACF_POINTS = 30
 #: The B1 ratio needs at least this many averages (with 2, B1 = 1 for every noise).
 MIN_B1_POINTS = 3
-#: Stable32 reads B1 only where ADEV and HDEV keep at least this many terms ...
-MIN_B1_TERMS = 8
-#: ... and the other estimators at least this many frequency averages (TOTDEV: 4); at a
-#: level with fewer, alpha is the previous level's (Stable32's tables of PHASE.DAT).
-MIN_B1_AVERAGES = {"totdev": 4}
+#: Stable32 reads B1 only where at least this many frequency averages K remain (ADEV and
+#: HDEV 10, TOTDEV 4, the others 8); at a level with fewer, alpha is the previous level's
+#: (its tables of PHASE.DAT and of a 10,000-point flicker FM record).
+MIN_B1_AVERAGES = {"adev": 10, "hdev": 10, "totdev": 4}
 DEFAULT_B1_AVERAGES = 8
 
 
@@ -52,21 +51,18 @@ NOISE_ID_ESTIMATORS = {name: NoiseRule(dmax, name) for name, dmax in
 def b1_rule(estimator: str | None, n: int, m: int, k: int) -> tuple[bool, int]:
     """Whether B1 decides at factor ``m`` (``k`` frequency averages of N = ``n`` phase
     points), and the sample size its theoretical values take: the estimator's term count
-    plus one (K for ADEV; about N for the overlapping estimators), as Stable32.
+    n (Stable32's "#": K - 1 for ADEV, about N for the overlapping estimators), as Stable32.
 
     Without an estimator (a plain dmax): B1 of the K averages wherever K >= 3.
 
-    >>> b1_rule("adev", 1001, 111, 9), b1_rule("adev", 1001, 113, 8), b1_rule("oadev", 1001, 113, 8)
-    ((True, 9), (False, 8), (True, 776))
+    >>> b1_rule("adev", 1001, 100, 10), b1_rule("adev", 1001, 101, 9), b1_rule("oadev", 1001, 113, 8)
+    ((True, 9), (False, 8), (True, 775))
     """
     if estimator is None:
         return k >= MIN_B1_POINTS, k
     terms = int(term_counts(estimator, n, np.array([m], dtype=np.int64))[0])
-    if estimator in ("adev", "hdev"):
-        enough = terms >= MIN_B1_TERMS
-    else:
-        enough = k >= MIN_B1_AVERAGES.get(estimator, DEFAULT_B1_AVERAGES)
-    return enough and k >= MIN_B1_POINTS, terms + 1
+    enough = k >= MIN_B1_AVERAGES.get(estimator, DEFAULT_B1_AVERAGES)
+    return enough and k >= MIN_B1_POINTS, terms
 #: Offsets per cluster at which R(n)'s modified Allan variance is sampled (O(N / m) per level).
 RN_SUBSAMPLES = 64
 
@@ -86,28 +82,31 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
        and on simulated flicker FM (N = 2**14) it gave alpha = -1 in 0 of 20
        series at every m >= 2, against 20 of 20 decimated at m = 2 and 4.
     2. If at least K = floor((N - 1) / m) = 30 frequency averages remain (compiled:
-       :func:`avar._kernels.noise_id.lag1_alpha_decimated`): remove a quadratic
-       (frequency offset and drift), then with r1 the lag-1 autocorrelation
-       r1 = sum (z_i - zbar)(z_{i+1} - zbar) / sum (z_i - zbar)**2 and
+       :func:`avar._kernels.noise_id.lag1_alpha_decimated`): remove a line
+       (the frequency offset; not a drift, as Stable32), then with r1 the lag-1
+       autocorrelation of the n points left, as Stable32 forms it,
+       r1 = (sum (z_i - zbar)(z_{i+1} - zbar) / n) / (sum (z_i - zbar)**2 / (n - 1)), and
        rho = r1 / (1 + r1), difference z until rho < 0.25 or d = dmax
        differences were taken (dmax = 2; 3 for the Hadamard estimators), and
        alpha = 2 - round(2 rho) - 2 d (``numpy.round``, as ``allantools``).
     3. Otherwise Barnes's B1 ratio of the K frequency averages,
        B1 = (their sample variance) / (their Allan variance), is compared
        with its values for random-walk, flicker and white FM and PM,
-       B1(n + 1, mu) (mu = 1, 0, -1, -2), at the geometric means of
+       B1(n, mu) (mu = 1, 0, -1, -2), at the geometric means of
        neighbours, where n is the estimator's term count (Stable32's "#"):
        K - 1 for ADEV, about N for the overlapping estimators (so that, as in
        Stable32, B1 of few averages does not reach random-walk FM there).
        For PM, R(n) = MVAR / AVAR against the geometric mean of its values
        1 / m (white PM) and that of flicker PM splits alpha = 2 from 1 (NIST
        SP 1065 section 5.6; MVAR is sampled at 64 offsets per cluster).
-    4. Stable32 reads B1 only while ADEV and HDEV keep n >= 8 terms, TOTDEV
-       K >= 4 averages and the other estimators K >= 8; beyond (or for a
-       constant series) alpha is that of the nearest smaller m identified
-       (or larger; 0 if none is). These rules reproduce the noise column of
-       all 991 rows of Stable32 1.60's all-tau tables of its PHASE.DAT (ADEV,
-       OADEV, MDEV, TDEV, HDEV, OHDEV, TOTDEV).
+    4. Stable32 reads B1 only while K >= 10 averages remain for ADEV and
+       HDEV, K >= 4 for TOTDEV and K >= 8 for the other estimators; beyond
+       (or for a constant series) alpha is that of the nearest smaller m
+       identified (or larger; 0 if none is). These rules reproduce the noise
+       column of 2,025 of the 2,026 rows of Stable32's all-tau tables of its
+       PHASE.DAT (phase data: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV, TOTDEV)
+       and of a 10,000-point flicker FM record (frequency data: ADEV, OADEV,
+       MDEV, HDEV, TOTDEV).
 
     The result is clipped to -2 .. 2. No drift is removed for B1 and R(n)
     (as Stable32 and ``allantools``): remove it first if the data have one.
@@ -174,8 +173,8 @@ def phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float = 0.0, lin
     """:func:`identify_noise` without validation: ``x`` contiguous finite float64 phase, ``m`` int64 in 1 .. N - 1.
 
     ``drift``: ``x`` is the phase less ``drift * k (k - 1) / 2`` (a removed
-    linear frequency drift, to which the lag-1 method is blind); B1 and R(n),
-    which see it, get it back. ``line_free``: ``x`` has no large line (its
+    linear frequency drift); every method gets it back (Stable32 identifies the
+    noise of the data as they are). ``line_free``: ``x`` has no large line (its
     mean frequency was removed), so R(n)'s running sum needs no conditioning.
     """
     return _fill(_raw_phase_noise(x, m, dmax, drift, line_free), m)
@@ -204,7 +203,8 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
     for i, factor in enumerate(m.tolist()):
         count = int(stats[i, 0])
         if count >= MIN_ACF_POINTS:
-            alpha[i] = lag1_alpha_from_moments(stats[i], int(dmax))
+            # the moments are those of the phase less its drift, which the lag-1 rule sees
+            alpha[i] = ILL_CONDITIONED if drift else lag1_alpha_from_moments(stats[i], int(dmax))
             if alpha[i] == ILL_CONDITIONED:
                 undecided.append(i)
         elif (rule := b1_rule(getattr(dmax, "estimator", None), n, factor, count))[0]:
@@ -244,7 +244,8 @@ def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line
     alpha = np.full(m.size, np.nan)
     if acf.any():
         found = np.empty(int(acf.sum()))
-        (lag1_levels_split if found.size > 1 else lag1_levels)(x, m[acf], int(dmax), found)
+        seen = x + drift * _triangular(np.arange(n, dtype=np.float64)) if drift else x  # the drift is data
+        (lag1_levels_split if found.size > 1 else lag1_levels)(seen, m[acf], int(dmax), found)
         alpha[acf] = found
     if not acf.all():
         lazy: dict[int, np.ndarray] = {}
@@ -294,7 +295,7 @@ def lag1_alpha(z: np.ndarray, dmax: int) -> float:
         power = float(np.dot(centred, centred))
         if power == 0.0:
             return np.nan
-        r1 = float(np.dot(centred[:-1], centred[1:])) / power
+        r1 = float(np.dot(centred[:-1], centred[1:])) / power * (z.size - 1) / z.size
         rho = r1 / (1.0 + r1)
         if rho < 0.25 or d >= dmax:
             return float(2 - np.round(2.0 * rho) - 2 * d)
