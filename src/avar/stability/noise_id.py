@@ -103,10 +103,9 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
        HDEV, K >= 4 for TOTDEV and K >= 8 for the other estimators; beyond
        (or for a constant series) alpha is that of the nearest smaller m
        identified (or larger; 0 if none is). These rules reproduce the noise
-       column of 2,025 of the 2,026 rows of Stable32's all-tau tables of its
-       PHASE.DAT (phase data: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV, TOTDEV)
-       and of a 10,000-point flicker FM record (frequency data: ADEV, OADEV,
-       MDEV, HDEV, TOTDEV).
+       column of 2,415 of the 2,416 rows of Stable32's all-tau tables of ADEV,
+       OADEV, MDEV, TDEV, HDEV, OHDEV and TOTDEV of its PHASE.DAT (phase
+       data) and of a 10,000-point flicker FM record (frequency data).
 
     The result is clipped to -2 .. 2. No drift is removed for B1 and R(n)
     (as Stable32 and ``allantools``): remove it first if the data have one.
