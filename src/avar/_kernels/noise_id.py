@@ -283,3 +283,49 @@ def rn_clusters(y, centre, slope, scale, step, z, running):
             last = base + step - 1
             phase += cluster + ((y[last] - centre) - slope * last) * scale
             z[k + 1] = phase
+
+
+@njit(cache=True, nogil=True)
+def moments_with_drift(row, drift, m):
+    """The moments ``row`` of one level (see :func:`_order_stats`) of the decimated phase
+    z_i (i = 0 .. C, z_0 = 0) with ``drift * (i m) (i m - 1) / 2`` added back to it.
+
+    With p_i = a i**2 + b i (a = drift m**2 / 2, b = -drift m / 2): the sums of p, t p,
+    t**2 p, p**2 and of its differences (2 a (2 j + 1) / 2 + ..., then the constant 2 a) are
+    power sums; the cross sums follow from those of z (sum i z = sum t z + h sum z, ...,
+    sum j (z_{j+1} - z_j) = C z_C - sum z). Differences of order 3 and up lose p.
+    """
+    out = row.copy()
+    c = row[0]
+    h = c / 2.0
+    a = drift * m * m / 2.0
+    b = -drift * m / 2.0
+    s1_ = c * (c + 1.0) / 2.0
+    s2_ = c * (c + 1.0) * (2.0 * c + 1.0) / 6.0
+    s3_ = s1_ * s1_
+    s4_ = c * (c + 1.0) * (2.0 * c + 1.0) * (3.0 * c * c + 3.0 * c - 1.0) / 30.0
+    p_sum = a * s2_ + b * s1_
+    ip_sum = a * s3_ + b * s2_
+    iip_sum = a * s4_ + b * s3_
+    z_sum, z_t, z_t2 = row[1], row[2], row[3]
+    iz = z_t + h * z_sum
+    iiz = z_t2 + 2.0 * h * z_t + h * h * z_sum
+    out[1] = z_sum + p_sum
+    out[2] = z_t + ip_sum - h * p_sum
+    out[3] = z_t2 + iip_sum - 2.0 * h * ip_sum + h * h * p_sum
+    out[4] = row[4] + 2.0 * (a * iiz + b * iz) + a * a * s4_ + 2.0 * a * b * s3_ + b * b * s2_
+    # first differences: dp_j = 2 a j + (a + b), j = 0 .. C - 1
+    t1 = c * (c - 1.0) / 2.0
+    t2 = (c - 1.0) * c * (2.0 * c - 1.0) / 6.0
+    z_last = row[9]
+    jdz = c * z_last - z_sum  # sum j (z_{j+1} - z_j), z_0 = 0
+    out[5] = (row[5] + 2.0 * ((a + b) * z_last + 2.0 * a * jdz)
+              + 4.0 * a * a * t2 + 4.0 * a * (a + b) * t1 + (a + b) * (a + b) * c)
+    # second differences gain the constant 2 a (C - 1 of them)
+    out[6] = row[6] + 4.0 * a * (row[11] - row[10]) + 4.0 * a * a * (c - 1.0)
+    out[9] = z_last + a * c * c + b * c
+    out[10] = row[10] + a + b
+    out[11] = row[11] + a * (2.0 * c - 1.0) + b
+    out[12] = row[12] + 2.0 * a
+    out[13] = row[13] + 2.0 * a
+    return out

@@ -193,7 +193,7 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
     only for a level whose moments lost too many digits to cancellation (a
     frequency drift far above the noise in ADEV).
     """
-    from avar._kernels.noise_id import ILL_CONDITIONED, lag1_alpha_from_moments
+    from avar._kernels.noise_id import ILL_CONDITIONED, lag1_alpha_from_moments, moments_with_drift
 
     alpha = np.full(m.size, np.nan)
     undecided = []
@@ -203,7 +203,8 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
         count = int(stats[i, 0])
         if count >= MIN_ACF_POINTS:
             # the moments are those of the phase less its drift, which the lag-1 rule sees
-            alpha[i] = ILL_CONDITIONED if drift else lag1_alpha_from_moments(stats[i], int(dmax))
+            row = moments_with_drift(stats[i], drift, factor) if drift else stats[i]
+            alpha[i] = lag1_alpha_from_moments(row, int(dmax))
             if alpha[i] == ILL_CONDITIONED:
                 undecided.append(i)
         elif (rule := b1_rule(getattr(dmax, "estimator", None), n, factor, count))[0]:
