@@ -75,12 +75,12 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
     1. The phase is decimated to x[0], x[m], x[2m], ..., whose differences
        are the non-overlapping frequency averages of m samples (Riley and
        Greenhall 2004), for every estimator, modified ones included, as
-       ``allantools.autocorr_noise_id`` does. Averaging the phase over blocks
-       of m instead (the modified estimators' own filter) misidentifies
-       flicker FM: in the continuous limit its twice-differenced block means
-       have rho = -0.04 (Greenhall's s_z with F = 1), read as random-walk FM,
-       and on simulated flicker FM (N = 2**14) it gave alpha = -1 in 0 of 20
-       series at every m >= 2, against 20 of 20 decimated at m = 2 and 4.
+       ``allantools.autocorr_noise_id`` does, and as Stable32 does (its MDEV
+       and OADEV tables of the flicker FM record print the same alpha at
+       every m; block means of the phase would miss 59 of MDEV's 113 lag-1
+       rows). Averaging the phase also misidentifies flicker FM: in the
+       continuous limit its twice-differenced block means have rho = -0.04
+       (Greenhall's s_z with F = 1), read as random-walk FM.
     2. If at least K = floor((N - 1) / m) = 30 frequency averages remain (compiled:
        :func:`avar._kernels.noise_id.lag1_alpha_decimated`): remove a line
        (the frequency offset; not a drift, as Stable32), then with r1 the lag-1
@@ -107,8 +107,8 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
        OADEV, MDEV, TDEV, HDEV, OHDEV and TOTDEV of its PHASE.DAT (phase
        data) and of a 10,000-point flicker FM record (frequency data).
 
-    The result is clipped to -2 .. 2. No drift is removed for B1 and R(n)
-    (as Stable32 and ``allantools``): remove it first if the data have one.
+    The result is clipped to -2 .. 2. No frequency drift is removed (as
+    Stable32): remove it first if the data have one.
 
     Parameters
     ----------
