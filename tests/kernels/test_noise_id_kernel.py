@@ -5,21 +5,21 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avar._kernels.noise_id import lag1_alpha_decimated
+from avar._kernels.noise_id import lag1_alpha_decimated, moments_with_drift
 from avar.stability.noise_id import lag1_alpha
 
 
 def plain_alpha(x: np.ndarray, m: int, dmax: int) -> float:
-    """Decimate, remove the least-squares quadratic (numpy.polynomial), then the NumPy lag-1 rule."""
+    """Decimate, remove the least-squares line (numpy.polynomial), then the NumPy lag-1 rule."""
     z = x[::m]
     u = np.linspace(-1.0, 1.0, z.size)
-    trend = np.polynomial.polynomial.polyval(u, np.polynomial.polynomial.polyfit(u, z, 2))
+    trend = np.polynomial.polynomial.polyval(u, np.polynomial.polynomial.polyfit(u, z, 1))
     return lag1_alpha(z - trend, dmax)
 
 
 def series(kind: str, n: int, seed: int) -> np.ndarray:
     w = np.random.default_rng(seed).standard_normal(n)
-    drift = 1e3 + 0.5 * np.arange(n) + 1e-4 * np.arange(n) ** 2  # removed by both
+    drift = 1e3 + 0.5 * np.arange(n)  # a phase and a frequency offset: removed by both
     return {"white pm": w, "white fm": np.cumsum(w), "rw fm": np.cumsum(np.cumsum(w))}[kind] + drift
 
 
@@ -52,3 +52,31 @@ def test_levels_serial_split_and_single_agree(factors):
     single = [lag1_alpha_decimated(x, int(f), 2) for f in m]
     np.testing.assert_array_equal(serial, single)
     np.testing.assert_array_equal(split, single)
+
+
+@pytest.mark.parametrize("kind", ["white pm", "white fm"])
+def test_a_frequency_drift_stays_for_the_differences(kind):
+    # only the line is removed (Stable32): a drift's parabola reaches the differencing, which
+    # the twin reproduces, and second differences still read white PM / white FM
+    for seed in range(4):
+        x = series(kind, 3000, seed) + 1e-3 * np.arange(3000.0) ** 2
+        got = lag1_alpha_decimated(x, 1, 2)
+        assert got == plain_alpha(x, 1, 2) == (2.0 if kind == "white pm" else 0.0)
+
+
+def plain_moments(z: np.ndarray) -> np.ndarray:
+    """The 16 moments of :data:`avar._kernels.pyramid.MOMENTS` of points z_0 .. z_C, by NumPy."""
+    c = z.size - 1
+    t = np.arange(c + 1) - c / 2.0
+    d1, d2, d3, d4 = (np.diff(z, k) for k in (1, 2, 3, 4))
+    return np.array([c, z.sum(), (t * z).sum(), (t * t * z).sum(), (z * z).sum(), (d1 * d1).sum(), (d2 * d2).sum(),
+                     (d3 * d3).sum(), (d4 * d4).sum(), z[-1], d1[0], d1[-1], d2[0], d2[-1], d3[0], d3[-1]])
+
+
+@pytest.mark.parametrize("count, m, drift", [(5, 1, 0.3), (40, 7, 3e-3), (333, 64, -2e-7)])
+def test_moments_with_drift_equal_the_moments_of_the_drifted_points(count, m, drift):
+    z = np.concatenate(([0.0], np.cumsum(np.random.default_rng(count).standard_normal(count))))
+    i = np.arange(count + 1.0) * m
+    want = plain_moments(z + drift * i * (i - 1.0) / 2.0)
+    got = moments_with_drift(plain_moments(z), drift, m)
+    np.testing.assert_allclose(got, want, rtol=1e-11, atol=1e-11 * np.abs(want).max())

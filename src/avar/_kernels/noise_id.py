@@ -1,9 +1,9 @@
 """Lag-1 autocorrelation noise identification (numba).
 
 Per averaging factor m: decimate the phase to x[0], x[m], x[2m], ..., remove a
-least-squares quadratic, then difference until the lag-1 autocorrelation says
-the series is stationary enough. Two streaming passes over the K = N / m
-decimated points and no workspace: the first sums the quadratic's
+least-squares line (the frequency offset, as Stable32), then difference until the lag-1
+autocorrelation says the series is stationary enough. Two streaming passes over the K = N / m
+decimated points and no workspace: the first sums the line's
 projections, the second forms the residuals and their differences on the fly and
 accumulates, for two orders of difference at a time, the sum, the sum of squares and the lag-1 sum of products. The plain
 twin is :func:`avar.stability.noise_id.lag1_alpha` (NumPy), which the tests
@@ -17,16 +17,21 @@ from numba import njit, prange
 
 #: Sums may be reassociated (vectorized): the statistic is a ratio compared with 0.25 and rounded.
 _FAST = {"reassoc", "contract"}
+#: Remove a least-squares quadratic (frequency drift too) rather than a line before the lag-1
+#: rule. Stable32 removes only the line: on its table of a 10,000-point flicker FM record (OADEV,
+#: m = 326, 30 averages) the quadratic turns its white FM into flicker PM (alpha 0.52 vs 0.46).
+QUADRATIC = False
 
 
 @njit(cache=True, nogil=True)
 def lag1_alpha_decimated(x, m, dmax):
     """alpha of x[0], x[m], x[2m], ... by the lag-1 autocorrelation (Riley and Greenhall 2004).
 
-    The decimated series z (K points) loses its least-squares quadratic,
-    computed with the discrete orthogonal polynomials 1, t, t**2 - (K**2 - 1) / 12
-    of the centred index t (three sums, no linear system). Then, with
-    r1 = sum (z_i - zbar)(z_{i+1} - zbar) / sum (z_i - zbar)**2 and
+    The decimated series z (K points) loses its least-squares line (the
+    quadratic too if :data:`QUADRATIC`), computed with the discrete orthogonal
+    polynomials 1, t, t**2 - (K**2 - 1) / 12 of the centred index t (sums, no
+    linear system). Then, with n points left,
+    r1 = (sum (z_i - zbar)(z_{i+1} - zbar) / n) / (sum (z_i - zbar)**2 / (n - 1)) and
     rho = r1 / (1 + r1), z is differenced until rho < 0.25 or d = dmax, and
     alpha = 2 - round(2 rho) - 2 d (round half to even, as ``numpy.round``).
     Returns NaN for a constant series. Needs K >= 3 and dmax <= 3.
@@ -38,7 +43,7 @@ def lag1_alpha_decimated(x, m, dmax):
     kf = float(k)
     a0 = s0 / kf
     a1 = s1 / (kf * (kf * kf - 1.0) / 12.0)
-    a2 = s2 / (kf * (kf * kf - 1.0) * (kf * kf - 4.0) / 180.0) if k > 2 else 0.0
+    a2 = s2 / (kf * (kf * kf - 1.0) * (kf * kf - 4.0) / 180.0) if QUADRATIC and k > 2 else 0.0
     stats = np.zeros((4, 5))  # per order d: sum, sum of squares, lag-1 products, first, last value
     for d in range(dmax + 1):
         if d % 2 == 0:  # orders d and d + 1 in one pass (most series stop at d = 0 or 1)
@@ -50,7 +55,7 @@ def lag1_alpha_decimated(x, m, dmax):
         if not power > 0.0:
             return np.nan
         lag = products - mean * (2.0 * total - first - last) + (length - 1) * mean * mean
-        r1 = lag / power
+        r1 = lag / power * (length - 1.0) / length  # Stable32: the variance over n - 1
         rho = r1 / (1.0 + r1)
         if rho < 0.25 or d >= dmax:
             return 2.0 - np.round(2.0 * rho) - 2.0 * d
@@ -180,7 +185,7 @@ KAPPA_MAX = 1e6
 @njit(cache=True, nogil=True)
 def _order_stats(row, d):
     """total, squares, first, last of the order-``d`` differences of the residual phase
-    (its least-squares quadratic removed), and the raw sum of squares ``squares`` was derived from,
+    (its least-squares line, or quadratic, removed), and the raw sum of squares ``squares`` was derived from,
     from the moments of :mod:`avar._kernels.pyramid` (``row``: one level, see ``MOMENTS``)."""
     c = row[0]
     k = c + 1.0
@@ -190,7 +195,7 @@ def _order_stats(row, d):
     s2 = row[3] - c2 * s0  # sum (t^2 - c2) z
     a0 = s0 / k
     a1 = s1 / (k * (k * k - 1.0) / 12.0)
-    a2 = s2 / (k * (k * k - 1.0) * (k * k - 4.0) / 180.0) if k > 2.0 else 0.0
+    a2 = s2 / (k * (k * k - 1.0) * (k * k - 4.0) / 180.0) if QUADRATIC and k > 2.0 else 0.0
     z_last, v_first, v_last = row[9], row[10], row[11]
     if d == 0:  # r = z - q(t): orthogonal projections of z removed
         squares = q0 - s0 * a0 - s1 * a1 - s2 * a2
@@ -239,7 +244,7 @@ def lag1_alpha_from_moments(row, dmax):
             return np.nan
         products = (2.0 * squares - first * first - last * last - n_squares) / 2.0
         lag = products - mean * (2.0 * total - first - last) + (length - 1.0) * mean * mean
-        r1 = lag / power
+        r1 = lag / power * (length - 1.0) / length  # Stable32: the variance over n - 1
         rho = r1 / (1.0 + r1)
         if rho < 0.25 or d >= dmax:
             return 2.0 - np.round(2.0 * rho) - 2.0 * d
@@ -278,3 +283,49 @@ def rn_clusters(y, centre, slope, scale, step, z, running):
             last = base + step - 1
             phase += cluster + ((y[last] - centre) - slope * last) * scale
             z[k + 1] = phase
+
+
+@njit(cache=True, nogil=True)
+def moments_with_drift(row, drift, m):
+    """The moments ``row`` of one level (see :func:`_order_stats`) of the decimated phase
+    z_i (i = 0 .. C, z_0 = 0) with ``drift * (i m) (i m - 1) / 2`` added back to it.
+
+    With p_i = a i**2 + b i (a = drift m**2 / 2, b = -drift m / 2): the sums of p, t p,
+    t**2 p, p**2 and of its differences (2 a (2 j + 1) / 2 + ..., then the constant 2 a) are
+    power sums; the cross sums follow from those of z (sum i z = sum t z + h sum z, ...,
+    sum j (z_{j+1} - z_j) = C z_C - sum z). Differences of order 3 and up lose p.
+    """
+    out = row.copy()
+    c = row[0]
+    h = c / 2.0
+    a = drift * m * m / 2.0
+    b = -drift * m / 2.0
+    s1_ = c * (c + 1.0) / 2.0
+    s2_ = c * (c + 1.0) * (2.0 * c + 1.0) / 6.0
+    s3_ = s1_ * s1_
+    s4_ = c * (c + 1.0) * (2.0 * c + 1.0) * (3.0 * c * c + 3.0 * c - 1.0) / 30.0
+    p_sum = a * s2_ + b * s1_
+    ip_sum = a * s3_ + b * s2_
+    iip_sum = a * s4_ + b * s3_
+    z_sum, z_t, z_t2 = row[1], row[2], row[3]
+    iz = z_t + h * z_sum
+    iiz = z_t2 + 2.0 * h * z_t + h * h * z_sum
+    out[1] = z_sum + p_sum
+    out[2] = z_t + ip_sum - h * p_sum
+    out[3] = z_t2 + iip_sum - 2.0 * h * ip_sum + h * h * p_sum
+    out[4] = row[4] + 2.0 * (a * iiz + b * iz) + a * a * s4_ + 2.0 * a * b * s3_ + b * b * s2_
+    # first differences: dp_j = 2 a j + (a + b), j = 0 .. C - 1
+    t1 = c * (c - 1.0) / 2.0
+    t2 = (c - 1.0) * c * (2.0 * c - 1.0) / 6.0
+    z_last = row[9]
+    jdz = c * z_last - z_sum  # sum j (z_{j+1} - z_j), z_0 = 0
+    out[5] = (row[5] + 2.0 * ((a + b) * z_last + 2.0 * a * jdz)
+              + 4.0 * a * a * t2 + 4.0 * a * (a + b) * t1 + (a + b) * (a + b) * c)
+    # second differences gain the constant 2 a (C - 1 of them)
+    out[6] = row[6] + 4.0 * a * (row[11] - row[10]) + 4.0 * a * a * (c - 1.0)
+    out[9] = z_last + a * c * c + b * c
+    out[10] = row[10] + a + b
+    out[11] = row[11] + a * (2.0 * c - 1.0) + b
+    out[12] = row[12] + 2.0 * a
+    out[13] = row[13] + 2.0 * a
+    return out

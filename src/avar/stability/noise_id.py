@@ -1,9 +1,12 @@
 """Power-law noise identification per averaging factor: :func:`identify_noise`.
 
 The dominant power-law noise S_y(f) ~ f**alpha at each level, as Stable32
-does it: the lag-1 autocorrelation of the decimated and differenced phase (Riley and Greenhall 2004) where at least 30 points remain,
+does it: the lag-1 autocorrelation of the decimated and differenced phase
+(Riley and Greenhall 2004) where at least 30 frequency averages remain,
 Barnes's B1 ratio (with the R(n) ratio to split white from flicker PM) where
-fewer remain. Each level costs O(N / m) after one pass over the data.
+fewer remain, and the previous level's alpha where too few remain for B1
+(Stable32's thresholds, per estimator). Each level costs O(N / m) after one
+pass over the data.
 """
 
 from __future__ import annotations
@@ -14,13 +17,52 @@ from typing import Any
 import numpy as np
 
 from avar._validation import short_repr
+from avar.stability.deviation_grids import term_counts
 
-#: The lag-1 autocorrelation is used when at least this many points remain at a level.
+#: The lag-1 autocorrelation is used where at least this many frequency averages K = (N - 1) // m remain
+#: (Stable32 switches to B1 at K = 29: its MDEV table of an OCXO's 19,982 readings, m = 659 -> 672).
 MIN_ACF_POINTS = 30
 #: The B1 ratio needs at least this many averages (with 2, B1 = 1 for every noise).
 MIN_B1_POINTS = 3
-#: Estimator -> largest number of differences of the lag-1 method (3 for the Hadamard family).
-NOISE_ID_ESTIMATORS = {"adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3}
+#: Stable32 reads B1 only where at least this many frequency averages K remain (ADEV and
+#: HDEV 10, TOTDEV 4, the others 8); at a level with fewer, alpha is the previous level's
+#: (its tables of PHASE.DAT and of a 10,000-point flicker FM record).
+MIN_B1_AVERAGES = {"adev": 10, "hdev": 10, "totdev": 4}
+DEFAULT_B1_AVERAGES = 8
+
+
+class NoiseRule(int):
+    """The largest number of differences of the lag-1 method (an ``int``: 2, or 3 for the
+    Hadamard family) that also names its estimator, whose term count sets the B1 rule."""
+
+    estimator: str
+
+    def __new__(cls, dmax: int, estimator: str) -> NoiseRule:
+        rule = super().__new__(cls, dmax)
+        rule.estimator = estimator
+        return rule
+
+
+#: Estimator -> its :class:`NoiseRule` (the lag-1 method's dmax, and the estimator).
+NOISE_ID_ESTIMATORS = {name: NoiseRule(dmax, name) for name, dmax in
+                       {"adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3}.items()}
+
+
+def b1_rule(estimator: str | None, n: int, m: int, k: int) -> tuple[bool, int]:
+    """Whether B1 decides at factor ``m`` (``k`` frequency averages of N = ``n`` phase
+    points), and the sample size its theoretical values take: the estimator's term count
+    n (Stable32's "#": K - 1 for ADEV, about N for the overlapping estimators), as Stable32.
+
+    Without an estimator (a plain dmax): B1 of the K averages wherever K >= 3.
+
+    >>> b1_rule("adev", 1001, 100, 10), b1_rule("adev", 1001, 101, 9), b1_rule("oadev", 1001, 113, 8)
+    ((True, 9), (False, 8), (True, 775))
+    """
+    if estimator is None:
+        return k >= MIN_B1_POINTS, k
+    terms = int(term_counts(estimator, n, np.array([m], dtype=np.int64))[0])
+    enough = k >= MIN_B1_AVERAGES.get(estimator, DEFAULT_B1_AVERAGES)
+    return enough and k >= MIN_B1_POINTS, terms
 #: Offsets per cluster at which R(n)'s modified Allan variance is sampled (O(N / m) per level).
 RN_SUBSAMPLES = 64
 
@@ -33,31 +75,40 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
     1. The phase is decimated to x[0], x[m], x[2m], ..., whose differences
        are the non-overlapping frequency averages of m samples (Riley and
        Greenhall 2004), for every estimator, modified ones included, as
-       ``allantools.autocorr_noise_id`` does. Averaging the phase over blocks
-       of m instead (the modified estimators' own filter) misidentifies
-       flicker FM: in the continuous limit its twice-differenced block means
-       have rho = -0.04 (Greenhall's s_z with F = 1), read as random-walk FM,
-       and on simulated flicker FM (N = 2**14) it gave alpha = -1 in 0 of 20
-       series at every m >= 2, against 20 of 20 decimated at m = 2 and 4.
-    2. If at least 30 points remain (compiled:
-       :func:`avar._kernels.noise_id.lag1_alpha_decimated`): remove a quadratic
-       (frequency offset and drift), then with r1 the lag-1 autocorrelation
-       r1 = sum (z_i - zbar)(z_{i+1} - zbar) / sum (z_i - zbar)**2 and
+       ``allantools.autocorr_noise_id`` does, and as Stable32 does (its MDEV
+       and OADEV tables of the flicker FM record print the same alpha at
+       every m; block means of the phase would miss 59 of MDEV's 113 lag-1
+       rows). Averaging the phase also misidentifies flicker FM: in the
+       continuous limit its twice-differenced block means have rho = -0.04
+       (Greenhall's s_z with F = 1), read as random-walk FM.
+    2. If at least K = floor((N - 1) / m) = 30 frequency averages remain (compiled:
+       :func:`avar._kernels.noise_id.lag1_alpha_decimated`): remove a line
+       (the frequency offset; not a drift, as Stable32), then with r1 the lag-1
+       autocorrelation of the n points left, as Stable32 forms it,
+       r1 = (sum (z_i - zbar)(z_{i+1} - zbar) / n) / (sum (z_i - zbar)**2 / (n - 1)), and
        rho = r1 / (1 + r1), difference z until rho < 0.25 or d = dmax
        differences were taken (dmax = 2; 3 for the Hadamard estimators), and
        alpha = 2 - round(2 rho) - 2 d (``numpy.round``, as ``allantools``).
-    3. Otherwise Barnes's B1 ratio of the K = floor((N - 1) / m) frequency
-       averages, B1 = (their sample variance) / (their Allan variance), is
-       compared with its values for random-walk, flicker and white FM and PM,
-       B1(K, mu) (mu = 1, 0, -1, -2), at the geometric means of neighbours;
-       for PM, R(n) = MVAR / AVAR against the geometric mean of its values
+    3. Otherwise Barnes's B1 ratio of the K frequency averages,
+       B1 = (their sample variance) / (their Allan variance), is compared
+       with its values for random-walk, flicker and white FM and PM,
+       B1(n, mu) (mu = 1, 0, -1, -2), at the geometric means of
+       neighbours, where n is the estimator's term count (Stable32's "#"):
+       K - 1 for ADEV, about N for the overlapping estimators (so that, as in
+       Stable32, B1 of few averages does not reach random-walk FM there).
+       For PM, R(n) = MVAR / AVAR against the geometric mean of its values
        1 / m (white PM) and that of flicker PM splits alpha = 2 from 1 (NIST
        SP 1065 section 5.6; MVAR is sampled at 64 offsets per cluster).
-    4. With fewer than 3 averages (or a constant series) alpha is that of the
-       nearest smaller m identified (or larger; 0 if none is).
+    4. Stable32 reads B1 only while K >= 10 averages remain for ADEV and
+       HDEV, K >= 4 for TOTDEV and K >= 8 for the other estimators; beyond
+       (or for a constant series) alpha is that of the nearest smaller m
+       identified (or larger; 0 if none is). These rules reproduce the noise
+       column of 2,415 of the 2,416 rows of Stable32's all-tau tables of ADEV,
+       OADEV, MDEV, TDEV, HDEV, OHDEV and TOTDEV of its PHASE.DAT (phase
+       data) and of a 10,000-point flicker FM record (frequency data).
 
-    The result is clipped to -2 .. 2. No drift is removed for B1 and R(n)
-    (as Stable32 and ``allantools``): remove it first if the data have one.
+    The result is clipped to -2 .. 2. No frequency drift is removed (as
+    Stable32): remove it first if the data have one.
 
     Parameters
     ----------
@@ -67,7 +118,8 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
     factors : array_like of int
         Averaging factors m, 1 <= m < N.
     estimator : {"adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev"}
-        The deviation whose levels these are (it sets dmax).
+        The deviation whose levels these are (it sets dmax, B1's sample
+        size and where B1 stops).
 
     Returns
     -------
@@ -120,8 +172,8 @@ def phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float = 0.0, lin
     """:func:`identify_noise` without validation: ``x`` contiguous finite float64 phase, ``m`` int64 in 1 .. N - 1.
 
     ``drift``: ``x`` is the phase less ``drift * k (k - 1) / 2`` (a removed
-    linear frequency drift, to which the lag-1 method is blind); B1 and R(n),
-    which see it, get it back. ``line_free``: ``x`` has no large line (its
+    linear frequency drift); every method gets it back (Stable32 identifies the
+    noise of the data as they are). ``line_free``: ``x`` has no large line (its
     mean frequency was removed), so R(n)'s running sum needs no conditioning.
     """
     return _fill(_raw_phase_noise(x, m, dmax, drift, line_free), m)
@@ -141,7 +193,7 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
     only for a level whose moments lost too many digits to cancellation (a
     frequency drift far above the noise in ADEV).
     """
-    from avar._kernels.noise_id import ILL_CONDITIONED, lag1_alpha_from_moments
+    from avar._kernels.noise_id import ILL_CONDITIONED, lag1_alpha_from_moments, moments_with_drift
 
     alpha = np.full(m.size, np.nan)
     undecided = []
@@ -149,15 +201,17 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
     finest = None  # (step, z, running) of the finest R(n) stride computed so far
     for i, factor in enumerate(m.tolist()):
         count = int(stats[i, 0])
-        if count + 1 >= MIN_ACF_POINTS:
-            alpha[i] = lag1_alpha_from_moments(stats[i], dmax)
+        if count >= MIN_ACF_POINTS:
+            # the moments are those of the phase less its drift, which the lag-1 rule sees
+            row = moments_with_drift(stats[i], drift, factor) if drift else stats[i]
+            alpha[i] = lag1_alpha_from_moments(row, int(dmax))
             if alpha[i] == ILL_CONDITIONED:
                 undecided.append(i)
-        elif count >= MIN_B1_POINTS:
+        elif (rule := b1_rule(getattr(dmax, "estimator", None), n, factor, count))[0]:
             index = np.arange(count + 1) * factor
             points = np.concatenate(([0.0], np.cumsum(tails[i, :count])))
             alpha[i] = _b1_ratio_alpha(points + drift * _triangular(index.astype(np.float64)) if drift else points,
-                                       factor)
+                                       factor, rule[1])
             if np.isinf(alpha[i]):  # PM: R(n) at the stride it samples (a power of two here)
                 step = max(1, factor // RN_SUBSAMPLES)
                 if finest is None or step % finest[0]:  # one pass serves every coarser stride
@@ -186,11 +240,12 @@ def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line
     from avar._kernels.noise_id import lag1_levels, lag1_levels_split
 
     n = x.size
-    acf = (n - 1) // m + 1 >= MIN_ACF_POINTS
+    acf = (n - 1) // m >= MIN_ACF_POINTS
     alpha = np.full(m.size, np.nan)
     if acf.any():
         found = np.empty(int(acf.sum()))
-        (lag1_levels_split if found.size > 1 else lag1_levels)(x, m[acf], dmax, found)
+        seen = x + drift * _triangular(np.arange(n, dtype=np.float64)) if drift else x  # the drift is data
+        (lag1_levels_split if found.size > 1 else lag1_levels)(seen, m[acf], int(dmax), found)
         alpha[acf] = found
     if not acf.all():
         lazy: dict[int, np.ndarray] = {}
@@ -213,9 +268,10 @@ def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line
         for i in np.flatnonzero(~acf).tolist():
             factor = int(m[i])
             k = (n - 1) // factor
-            if k < MIN_B1_POINTS:
+            enough, size = b1_rule(getattr(dmax, "estimator", None), n, factor, k)
+            if not enough:
                 continue
-            alpha[i] = _b1_ratio_alpha(points(np.arange(0, k * factor + 1, factor)), factor)
+            alpha[i] = _b1_ratio_alpha(points(np.arange(0, k * factor + 1, factor)), factor, size)
             if np.isinf(alpha[i]):  # PM: R(n) splits white from flicker
                 alpha[i] = _rn_alpha(points, n, running, factor)
     return alpha
@@ -239,7 +295,7 @@ def lag1_alpha(z: np.ndarray, dmax: int) -> float:
         power = float(np.dot(centred, centred))
         if power == 0.0:
             return np.nan
-        r1 = float(np.dot(centred[:-1], centred[1:])) / power
+        r1 = float(np.dot(centred[:-1], centred[1:])) / power * (z.size - 1) / z.size
         rho = r1 / (1.0 + r1)
         if rho < 0.25 or d >= dmax:
             return float(2 - np.round(2.0 * rho) - 2 * d)
@@ -284,10 +340,11 @@ def b1_alpha(x: np.ndarray, cumsum: Any, m: int) -> float:
     return alpha
 
 
-def _b1_ratio_alpha(points: np.ndarray, m: int) -> float:
-    """alpha -2, -1 or 0 by B1 of the K averages between the K + 1 decimated phase ``points``;
-    NaN when their Allan variance is 0; inf for PM (R(n) decides)."""
-    k = points.size - 1
+def _b1_ratio_alpha(points: np.ndarray, m: int, size: int | None = None) -> float:
+    """alpha -2, -1 or 0 by B1 of the K averages between the K + 1 decimated phase ``points``,
+    against B1's theoretical values for ``size`` samples (default K); NaN when their Allan
+    variance is 0; inf for PM (R(n) decides)."""
+    k = points.size - 1 if size is None else size
     means = np.diff(points) / m
     allan = float(np.mean(np.diff(means) ** 2)) / 2.0
     if not allan > 0:
