@@ -169,3 +169,22 @@ def test_a_short_log_never_fits_more_terms_than_its_levels_support():
     parameters = sum(1 if c.shape is None else 2 for c in fit.components)
     assert parameters <= len(report.avs["x"]) - 2
     assert any("too short" in w for w in report.warnings)
+
+
+def test_spikes_are_warned_about_and_the_robust_report_gives_the_clean_terms():
+    n = int(1800 * FREQ)
+    rng = np.random.default_rng(8)
+    sigma = 1.2e-4 * math.sqrt(FREQ)
+    clean = sigma * rng.standard_normal(n) + np.cumsum(5e-5 / math.sqrt(FREQ) * rng.standard_normal(n))
+    spiked = clean.copy()
+    where = rng.choice(n, n // 20, replace=False)  # 5 % of the samples
+    spiked[where] += 20 * sigma * rng.choice([-1.0, 1.0], where.size)
+    truth = avar.noise_report(clean, gyro_units="rad/s", freq=FREQ)
+    plain = avar.noise_report(spiked, gyro_units="rad/s", freq=FREQ)
+    robust = avar.noise_report(spiked, gyro_units="rad/s", freq=FREQ, robust=True)
+    assert not truth.warnings
+    assert any("outliers" in w and "--robust" in w for w in plain.warnings)
+    assert plain.value("x", "WN") > 3 * truth.value("x", "WN")  # the spikes swamp the white noise
+    for process in ("WN", "RW"):
+        assert robust.value("x", process) == pytest.approx(truth.value("x", process), rel=0.10)
+    assert any("sets them aside" in w for w in robust.warnings)

@@ -297,7 +297,7 @@ def noise_report(
         rows.append(minimum_row(channel, kind, unit, av.levels, av.adev, lower, upper))
         notes = [departure] if departure else []
         if values is not None:
-            notes += data_warnings(channel, kind, values, av.freq, len(av))
+            notes += data_warnings(channel, kind, values, av.freq, len(av), robust=bool(robust))
         if kind is not None:
             white = [c.scale for c in fit.components if c.kind == "WN"]
             density = float(np.sqrt(white[0] / av.freq)) if white else None

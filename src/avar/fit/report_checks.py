@@ -21,8 +21,11 @@ __all__ = ["fit_check", "unit_warnings", "data_warnings", "FIT_TOLERANCE", "FIT_
 FIT_TOLERANCE = 0.10
 #: Share of the levels that must fit.
 FIT_SHARE = 0.90
-#: Robust z of a first difference beyond which a sample counts as an outlier.
+#: Robust z of a first difference beyond which a sample counts as an outlier (a Gaussian process,
+#: white or integrated, has Gaussian differences: 2e-9 of them beyond 6 robust deviations).
 OUTLIER_MAD = 6.0
+#: Share of such jumps above which a channel is warned about (heavy tails of real sensors stay below).
+OUTLIER_SHARE = 1e-3
 #: Range of the 1 s means, in units of their white-noise spread (from the samples' steps), beyond which a
 #: log is taken as moving or drifting strongly.
 MOVING_RATIO = 100.0
@@ -76,7 +79,8 @@ def unit_warnings(channel: str, kind: str | None, unit: str, values: np.ndarray,
     return out
 
 
-def data_warnings(channel: str, kind: str | None, values: np.ndarray, freq: float, levels: int) -> list[str]:
+def data_warnings(channel: str, kind: str | None, values: np.ndarray, freq: float, levels: int,
+                  robust: bool = False) -> list[str]:
     """Clipped, stuck, spiky, moving or too-short channels."""
     out = []
     x = np.asarray(values, dtype=np.float64)
@@ -98,9 +102,11 @@ def data_warnings(channel: str, kind: str | None, values: np.ndarray, freq: floa
         spread = 1.4826 * float(np.median(np.abs(steps - np.median(steps))))
         if spread > 0:
             outliers = int(np.count_nonzero(np.abs(steps - np.median(steps)) > OUTLIER_MAD * spread))
-            if outliers > max(5, 1e-4 * n):
+            if outliers > max(10, OUTLIER_SHARE * n):
+                remedy = "the robust Allan variance sets them aside" if robust else \
+                    "pass --robust (robust=True) to fit the clean process"
                 out.append(f"{channel}: {outliers} samples jump beyond {OUTLIER_MAD:g} robust deviations "
-                           "(outliers); pass --robust (robust=True) to fit the clean process")
+                           f"(outliers); {remedy}")
     else:
         out.append(f"{channel}: the channel is constant ({low:.6g}): no noise to fit")
     if levels < 8:
