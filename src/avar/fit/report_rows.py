@@ -78,7 +78,7 @@ def _ieee_row(channel: str, kind: str | None, unit: str | None, process: str, st
         custom = tuple(pd.NA if v is pd.NA else customary(process, v, kind)[0] for v in si)
     name = TERM_NAMES[kind][process]
     if process == "FN":
-        name += " (IEEE 952 B, AD plateau = 0.664 B)"
+        name += " B (AD = 0.664 B)"  # IEEE 952's convention, stated
     return _row(channel, kind, name, process, status, unit_of(process, kind, unit), si, custom_unit, custom, note=note)
 
 
@@ -142,7 +142,7 @@ def minimum_row(channel: str, kind: str | None, unit: str | None, tau: np.ndarra
         custom, custom_unit = tuple(v / DEG * 3600.0 for v in si), "deg/h"
     elif kind == ACCEL:
         custom, custom_unit = tuple(v / (G0 * 1e-6) for v in si), "ug"
-    return _row(channel, kind, "Allan deviation minimum (in-run bias stability)", "MIN", "measured",
+    return _row(channel, kind, "AD minimum (in-run bias stability)", "MIN", "measured",
                 _si_unit(kind, unit, unit or "u"), si, custom_unit, custom, tau=float(tau[at]),
                 note="the empirical minimum over the levels, with its chi-squared band")
 
