@@ -14,6 +14,7 @@ import pandas as pd
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
 from avar.stability.deviation_grids import ESTIMATORS, LONG_NAMES
+from avar.stability.statistics import DEVIATION_STATISTICS, EXTRA_LONG_NAMES, PAIR_STATISTICS
 
 #: Columns of :meth:`Deviation.summary`, in the order of Stable32's run table.
 SUMMARY_COLUMNS = ["Tau", "m", "N terms", "Alpha", "Min sigma", "Sigma", "Max sigma", "EDF"]
@@ -82,8 +83,9 @@ class Deviation:
         names = ("taus", "averaging_factors", "deviation", "variance", "n", "alpha", "edf", "lci", "uci")
         if len({len(getattr(self, name)) for name in names}) != 1:
             raise ValueError(f"{', '.join(names)} must have one length")
-        if self.estimator not in ESTIMATORS:
-            raise ValueError(f"estimator must be one of {ESTIMATORS}, got {short_repr(self.estimator)}")
+        known = (*ESTIMATORS, *DEVIATION_STATISTICS, *PAIR_STATISTICS)
+        if self.estimator not in known:
+            raise ValueError(f"estimator must be one of {sorted(set(known))}, got {short_repr(self.estimator)}")
         if self.data_type not in ("phase", "freq"):
             raise ValueError(f"data_type must be 'phase' or 'freq', got {short_repr(self.data_type)}")
         set_field(self, "rate", check_freq(self.rate, "rate"))
@@ -124,7 +126,7 @@ class Deviation:
     def describe(self) -> str:
         """One line: estimator, input, rate, levels and confidence."""
         return (
-            f"{self.name} ({LONG_NAMES[self.estimator]}) of {self.n_samples} {self.data_type} samples "
+            f"{self.name} ({LONG_NAMES.get(self.estimator) or EXTRA_LONG_NAMES.get(self.estimator, self.estimator)}) of {self.n_samples} {self.data_type} samples "
             f"at {self.rate:g} Hz, {len(self)} levels, {self.confidence:.3g} confidence"
         )
 
