@@ -49,6 +49,13 @@ _EXPORTS = {
     "mtie": "avar.stability.time_error",
     "tierms": "avar.stability.time_error",
     "pdev": "avar.stability.time_error",
+    "phase_to_frequency": "avar.stability.conversions",
+    "frequency_to_phase": "avar.stability.conversions",
+    "remove_drift": "avar.stability.conversions",
+    "Drift": "avar.stability.conversions",
+    "psd": "avar.stability.spectrum",
+    "psd_to_deviation": "avar.stability.spectrum",
+    "PowerSpectrum": "avar.stability.spectrum",
     "avlr": "avar.fit.avlr",
     "AvlrResult": "avar.fit.results",
     "ImuAvlrResult": "avar.fit.results",
@@ -64,7 +71,7 @@ _EXPORTS = {
 }
 
 #: Public submodules reached as attributes (``avar.datasets.load(...)``).
-_SUBMODULES = {"datasets": "avar.io.datasets"}
+_SUBMODULES = {"datasets": "avar.io.datasets", "noise": "avar.models.noise"}
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES])
 
