@@ -183,7 +183,10 @@ def codev_levels(x1, x2, m, gaps, extra):
         comp = 0.0
         count = 0
         for i in range(n - 2 * k):
-            if _window_count(gaps, i, 2 * k, extra) > 0:
+            if extra == 1:  # phase: the three points used
+                if gaps[i + 1] - gaps[i] + gaps[i + k + 1] - gaps[i + k] + gaps[i + 2 * k + 1] - gaps[i + 2 * k] > 0:
+                    continue
+            elif _window_count(gaps, i, 2 * k, extra) > 0:
                 continue
             a = x1[i + 2 * k] - 2.0 * x1[i + k] + x1[i]
             b = x2[i + 2 * k] - 2.0 * x2[i + k] + x2[i]
