@@ -56,6 +56,7 @@ _EXPORTS = {
     "three_cornered_hat": "avar.stability.clock_pairs",
     "ThreeCorneredHat": "avar.stability.clock_pairs",
     "gcodev": "avar.stability.clock_pairs",
+    "Stream": "avar.stability.stream",
     "psd": "avar.stability.spectrum",
     "psd_to_deviation": "avar.stability.spectrum",
     "PowerSpectrum": "avar.stability.spectrum",
