@@ -97,6 +97,11 @@ class Deviation:
         """The estimator's upper-case name, e.g. ``"OADEV"``."""
         return self.estimator.upper()
 
+    @property
+    def long_name(self) -> str:
+        """The statistic's long name, e.g. ``"overlapping Allan deviation"``."""
+        return LONG_NAMES.get(self.estimator) or EXTRA_LONG_NAMES.get(self.estimator, self.estimator)
+
     def __len__(self) -> int:
         return len(self.taus)
 
@@ -126,7 +131,7 @@ class Deviation:
     def describe(self) -> str:
         """One line: estimator, input, rate, levels and confidence."""
         return (
-            f"{self.name} ({LONG_NAMES.get(self.estimator) or EXTRA_LONG_NAMES.get(self.estimator, self.estimator)}) of {self.n_samples} {self.data_type} samples "
+            f"{self.name} ({self.long_name}) of {self.n_samples} {self.data_type} samples "
             f"at {self.rate:g} Hz, {len(self)} levels, {self.confidence:.3g} confidence"
         )
 
