@@ -43,14 +43,14 @@ def stream_update(chunk, is_freq, kind, state, ring_hi, ring_lo, m, sums, comps,
     ``state`` = [phase points stored, reference y_0, whether y_0 is set]; a
     frequency stream starts with X_0 = 0 stored (state[0] = 1).
     """
-    size = ring_hi.size
+    mask = ring_hi.size - 1  # a power of two
     for value in chunk:
         j = np.int64(state[0])
         if is_freq:
             if state[2] == 0.0:
                 state[1] = value
                 state[2] = 1.0
-            prev = (j - 1) % size
+            prev = (j - 1) & mask
             hi, lo = ring_hi[prev], ring_lo[prev]
             v = value - state[1]
             s = hi + v
@@ -61,16 +61,16 @@ def stream_update(chunk, is_freq, kind, state, ring_hi, ring_lo, m, sums, comps,
             lo = lo - (hi - s)
         else:
             hi, lo = value, 0.0
-        ring_hi[j % size] = hi
-        ring_lo[j % size] = lo
+        ring_hi[j & mask] = hi
+        ring_lo[j & mask] = lo
         state[0] = j + 1
         for level in range(m.size):
             k = m[level]
             if kind <= 1 or kind == 4:
                 if j < 2 * k or (kind == 1 and j % k != 0):
                     continue
-                d1 = _difference(ring_hi, ring_lo, j % size, (j - k) % size)
-                d0 = _difference(ring_hi, ring_lo, (j - k) % size, (j - 2 * k) % size)
+                d1 = _difference(ring_hi, ring_lo, j & mask, (j - k) & mask)
+                d0 = _difference(ring_hi, ring_lo, (j - k) & mask, (j - 2 * k) & mask)
                 term = d1 - d0
                 if kind == 4:  # the sum of the last m second differences
                     base = doffsets[level]
@@ -92,9 +92,9 @@ def stream_update(chunk, is_freq, kind, state, ring_hi, ring_lo, m, sums, comps,
             else:
                 if j < 3 * k or (kind == 3 and j % k != 0):
                     continue
-                d2 = _difference(ring_hi, ring_lo, j % size, (j - k) % size)
-                d1 = _difference(ring_hi, ring_lo, (j - k) % size, (j - 2 * k) % size)
-                d0 = _difference(ring_hi, ring_lo, (j - 2 * k) % size, (j - 3 * k) % size)
+                d2 = _difference(ring_hi, ring_lo, j & mask, (j - k) & mask)
+                d1 = _difference(ring_hi, ring_lo, (j - k) & mask, (j - 2 * k) & mask)
+                d0 = _difference(ring_hi, ring_lo, (j - 2 * k) & mask, (j - 3 * k) & mask)
                 term = (d2 - d1) - (d1 - d0)
             _add(sums, comps, level, term * term)
             counts[level] += 1

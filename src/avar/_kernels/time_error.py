@@ -55,7 +55,7 @@ def mtie_levels(x, m, gaps, extra, fill_low, fill_high):
         best = -np.inf
         count = 0
         for i in range(n - w + 1):
-            if _window_count(gaps, i, w - 1, extra) > 0:
+            if gaps[gaps.size - 1] > 0 and _window_count(gaps, i, w - 1, extra) > 0:
                 continue
             j = i + w - 1
             span = max(hmax[i], gmax[j]) - min(hmin[i], gmin[j])
@@ -74,27 +74,33 @@ def tierms_levels(x, m, gaps, extra):
 
     Phase data (``extra`` = 1) need only the two end points; frequency data
     the whole span (the phase difference sums the m values between them).
+    Summed in blocks of 256 terms, the block sums compensated (Kahan).
     """
     n = x.size
     sums = np.zeros(m.size)
     counts = np.zeros(m.size, dtype=np.int64)
+    clean = gaps[gaps.size - 1] == 0
     for level in range(m.size):
         k = m[level]
         total = 0.0
         comp = 0.0
         count = 0
-        for i in range(n - k):
-            if extra == 1:
-                if gaps[i + 1] - gaps[i] + gaps[i + k + 1] - gaps[i + k] > 0:
-                    continue
-            elif gaps[i + k] - gaps[i] > 0:
-                continue
-            d = x[i + k] - x[i]
-            y = d * d - comp  # Kahan summation
+        for start in range(0, n - k, 256):
+            block = 0.0
+            for i in range(start, min(start + 256, n - k)):
+                if not clean:
+                    if extra == 1:
+                        if gaps[i + 1] - gaps[i] + gaps[i + k + 1] - gaps[i + k] > 0:
+                            continue
+                    elif gaps[i + k] - gaps[i] > 0:
+                        continue
+                d = x[i + k] - x[i]
+                block += d * d
+                count += 1
+            y = block - comp
             t = total + y
             comp = (t - total) - y
             total = t
-            count += 1
         sums[level] = total
         counts[level] = count
     return sums, counts
@@ -156,7 +162,7 @@ def pdev_levels(x, m, gaps, extra):
                 d_new = x[i - 1 + k] - x[i - 1 + 2 * k]
                 w = w - d_old + d_new
                 s = s - c0 * d_old + cm * d_new + w
-            if _window_count(gaps, i, 2 * k - 1, extra) > 0:
+            if gaps[gaps.size - 1] > 0 and _window_count(gaps, i, 2 * k - 1, extra) > 0:
                 continue
             y = s * s - comp
             t = total + y

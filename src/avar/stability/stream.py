@@ -83,7 +83,7 @@ class Stream:
         self.statistic, self.data_type, self.confidence, self.alpha = statistic, data_type, float(confidence), fixed
         self.factors = grid_factors(taus, self.rate, 2**40, first_octave=0, context="of a stream")
         self._kind, span, self._k = STREAM_STATISTICS[statistic]
-        self._ring_hi = np.zeros(span * int(self.factors[-1]) + 1)
+        self._ring_hi = np.zeros(1 << (span * int(self.factors[-1])).bit_length())  # > span max(m), a power of 2
         self._ring_lo = np.zeros_like(self._ring_hi)
         self._state = np.array([1.0 if data_type == "freq" else 0.0, 0.0, 0.0])
         levels = self.factors.size
