@@ -145,3 +145,16 @@ def test_validation_names_the_argument():
         avar.tierms(np.arange(10.0), data_type="phase", taus=[100.0])
     res = avar.tierms(np.arange(10.0), data_type="phase")
     assert "TIERMS (time interval error rms)" in str(res)
+
+
+def test_noise_of_the_line_free_phase_is_the_deviation_familys():
+    from avar.stability.deviations import noise_exponents
+
+    rng = np.random.default_rng(12)
+    cases = [np.cumsum(rng.standard_normal(20000)), rng.standard_normal(20000),
+             np.cumsum(np.cumsum(rng.standard_normal(20000))) + 3.0 * np.arange(20000)]
+    for data in cases:
+        for data_type in ("phase", "freq"):
+            res = avar.tierms(data, data_type=data_type, taus="decade")
+            expected = noise_exponents("oadev", data, data_type, 1.0, res.averaging_factors)
+            assert res.alpha.tolist() == expected.tolist()

@@ -17,10 +17,10 @@ import numpy as np
 
 from avar._kernels.time_error import codev_levels
 from avar.stability.deviation_results import Deviation
-from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options, noise_exponents
+from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options
 from avar.stability.edf import chi2_bounds
 from avar.stability.grids import grid_factors
-from avar.stability.time_error import check_alpha, prepared_phase
+from avar.stability.time_error import check_alpha, level_noise, prepared_phase
 
 #: Statistics the three-cornered hat accepts (variances of one clock that add over independent clocks).
 HAT_STATISTICS = ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "pdev")
@@ -192,10 +192,7 @@ def gcodev(data_1: Any, data_2: Any, rate: float = 1.0, data_type: str = "freq",
     factors, sums, n = factors[keep], sums[keep], n[keep]
     variance = sums / (2.0 * n * (factors / rate) ** 2)
     deviation = np.sign(variance) * np.sqrt(np.abs(variance))
-    if fixed is None:
-        alpha_levels = noise_exponents("oadev", first, data_type, rate, factors)
-    else:
-        alpha_levels = np.full(factors.size, fixed, dtype=np.int64)
+    alpha_levels = level_noise(fixed, first, x1, gaps, data_type, rate, factors)
     nan = np.full(factors.size, np.nan)
     return Deviation(
         taus=factors / rate, averaging_factors=factors, deviation=deviation, variance=variance, n=n,

@@ -18,7 +18,7 @@ import numpy as np
 from avar._kernels.time_error import mtie_levels, pdev_levels, tierms_levels
 from avar._validation import short_repr
 from avar.stability.deviation_results import Deviation
-from avar.stability.deviations import _check_data, _check_options, noise_exponents
+from avar.stability.deviations import _check_data, _check_options, _noise_of_levels, noise_exponents
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.grids import grid_factors
 
@@ -110,10 +110,7 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     factors, deviation, variance, n = factors[keep], deviation[keep], variance[keep], n[keep]
     if not np.all(np.isfinite(variance)):
         raise ValueError(f"{statistic} overflows float64; rescale the data, e.g. to other units")
-    if fixed is None:
-        alpha_levels = noise_exponents("oadev", values, data_type, rate, factors)
-    else:
-        alpha_levels = np.full(factors.size, fixed, dtype=np.int64)
+    alpha_levels = level_noise(fixed, values, phase, gaps, data_type, rate, factors)
     if statistic == "pdev":  # PDEV spans 2m and averages N - 2m terms, as OADEV
         edf = estimator_edf("oadev", alpha_levels, factors, n_phase)
         if gaps[-1]:
@@ -126,6 +123,22 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         alpha=alpha_levels, edf=edf, lci=lci, uci=uci, estimator=statistic, data_type=data_type, rate=rate,
         n_samples=values.size, confidence=float(confidence),
     )
+
+
+def level_noise(fixed: int | None, values: np.ndarray, phase: np.ndarray, gaps: np.ndarray, data_type: str,
+                rate: float, factors: np.ndarray) -> np.ndarray:
+    """``alpha=`` at every level, or the noise identified as for OADEV (lag-1 autocorrelation, B1, R(n)).
+
+    Gap-free data: on the phase less the line through its end points (B1 and
+    R(n) are blind to a frequency offset, the lag-1 method removes its own
+    quadratic), which spares the identification a least-squares fit.
+    """
+    if fixed is not None:
+        return np.full(factors.size, fixed, dtype=np.int64)
+    if gaps[-1]:
+        return noise_exponents("oadev", values, data_type, rate, factors)
+    ramp = np.linspace(phase[0], phase[-1], phase.size)
+    return _noise_of_levels("oadev", np.ascontiguousarray(phase - ramp), 0.0, factors)
 
 
 def _missing_points(gaps: np.ndarray, extra: int, n_phase: int) -> np.ndarray:
