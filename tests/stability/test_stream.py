@@ -64,7 +64,7 @@ def test_stream_reports_partial_results_and_memory_is_bounded():
     assert res.deviation[0] == 0.0  # a parabola has no third difference
     stream.update(np.zeros(0))
     assert stream.n_samples == 8 and stream.n_phase == 8
-    assert stream._ring_hi.size == 64  # the last 3 max(m) + 1 points (a power of two), whatever the length
+    assert stream._ring_hi.size == 3 * 20 + 1  # the last 3 max(m) + 1 points, whatever the length
     assert stream.expected_terms().tolist() == [8 - 3 * 2, 8 - 3 * 20]
 
 

@@ -1,6 +1,6 @@
 """The compiled update of :class:`avar.Stream`: O(levels) per sample, memory bounded by the largest tau.
 
-State (all updated in place): ``ring_hi``/``ring_lo``, the last R phase
+State (all updated in place): ``hist_hi``/``hist_lo``, the last L phase
 points as double-double numbers (phase of frequency data is the running sum
 of y - y_first, in units of y times samples, accumulated with TwoSum so that
 no rounding accumulates); ``state`` = [points so far (as float), reference
@@ -17,41 +17,41 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
-def _difference(ring_hi, ring_lo, a, b):
-    """X_a - X_b of two double-double ring entries, rounded once."""
-    ah, bh = ring_hi[a], ring_hi[b]
+def _difference(hi, lo, a, b):
+    """X_a - X_b of two double-double entries, rounded once."""
+    ah, bh = hi[a], hi[b]
     s = ah - bh
     bb = s - ah
     e = (ah - (s - bb)) + (-bh - bb)
-    return s + (e + (ring_lo[a] - ring_lo[b]))
+    return s + (e + (lo[a] - lo[b]))
 
 
 @njit(cache=True)
-def _add(sums, comps, level, value):
-    y = value - comps[level]
-    t = sums[level] + y
-    comps[level] = (t - sums[level]) - y
-    sums[level] = t
-
-
-@njit(cache=True)
-def stream_update(chunk, is_freq, kind, state, ring_hi, ring_lo, m, sums, comps, counts, dring, doffsets, dsum,
+def stream_update(chunk, is_freq, kind, state, hist_hi, hist_lo, m, sums, comps, counts, dring, doffsets, dsum,
                   dcount):
     """Feed ``chunk`` (float64 samples). ``kind``: 0 Allan overlapping, 1 Allan non-overlapping,
     2 Hadamard overlapping, 3 Hadamard non-overlapping, 4 modified Allan.
 
-    ``state`` = [phase points stored, reference y_0, whether y_0 is set]; a
-    frequency stream starts with X_0 = 0 stored (state[0] = 1).
+    ``hist_hi``/``hist_lo``: the last L phase points, oldest first (L at least
+    span max(m)); ``state`` = [phase points so far, reference y_0, whether
+    y_0 is set]; a frequency stream starts with X_0 = 0 (state[0] = 1). The
+    chunk's phase points are appended to a copy of the history, then every
+    level runs over them with its sums in registers.
     """
-    mask = ring_hi.size - 1  # a power of two
-    for value in chunk:
-        j = np.int64(state[0])
+    size = hist_hi.size
+    c = chunk.size
+    buf_hi = np.empty(size + c)
+    buf_lo = np.empty(size + c)
+    buf_hi[:size] = hist_hi
+    buf_lo[:size] = hist_lo
+    p = np.int64(state[0])
+    for t in range(c):
+        value = chunk[t]
         if is_freq:
             if state[2] == 0.0:
                 state[1] = value
                 state[2] = 1.0
-            prev = (j - 1) & mask
-            hi, lo = ring_hi[prev], ring_lo[prev]
+            hi, lo = buf_hi[size + t - 1], buf_lo[size + t - 1]
             v = value - state[1]
             s = hi + v
             bb = s - hi
@@ -61,40 +61,47 @@ def stream_update(chunk, is_freq, kind, state, ring_hi, ring_lo, m, sums, comps,
             lo = lo - (hi - s)
         else:
             hi, lo = value, 0.0
-        ring_hi[j & mask] = hi
-        ring_lo[j & mask] = lo
-        state[0] = j + 1
-        for level in range(m.size):
-            k = m[level]
+        buf_hi[size + t] = hi
+        buf_lo[size + t] = lo
+    origin = p - size  # global index of buf[0]
+    for level in range(m.size):
+        k = m[level]
+        total, comp, count = sums[level], comps[level], counts[level]
+        base, dc, window = doffsets[level], dcount[level], dsum[level]
+        for q in range(size, size + c):
+            j = origin + q
             if kind <= 1 or kind == 4:
                 if j < 2 * k or (kind == 1 and j % k != 0):
                     continue
-                d1 = _difference(ring_hi, ring_lo, j & mask, (j - k) & mask)
-                d0 = _difference(ring_hi, ring_lo, (j - k) & mask, (j - 2 * k) & mask)
-                term = d1 - d0
+                term = _difference(buf_hi, buf_lo, q, q - k) - _difference(buf_hi, buf_lo, q - k, q - 2 * k)
                 if kind == 4:  # the sum of the last m second differences
-                    base = doffsets[level]
-                    c = dcount[level]
-                    old = dring[base + c % k] if c >= k else 0.0
-                    dring[base + c % k] = term
-                    c += 1
-                    dcount[level] = c
-                    if c % k == 0:  # exact window sum every m differences: rounding cannot drift
-                        total = 0.0
-                        for q in range(k):
-                            total += dring[base + q]
-                        dsum[level] = total
+                    slot = base + dc % k
+                    old = dring[slot] if dc >= k else 0.0
+                    dring[slot] = term
+                    dc += 1
+                    if dc % k == 0:  # exact window sum every m differences: rounding cannot drift
+                        window = 0.0
+                        for r in range(k):
+                            window += dring[base + r]
                     else:
-                        dsum[level] += term - old
-                    if c < k:
+                        window += term - old
+                    if dc < k:
                         continue
-                    term = dsum[level]
+                    term = window
             else:
                 if j < 3 * k or (kind == 3 and j % k != 0):
                     continue
-                d2 = _difference(ring_hi, ring_lo, j & mask, (j - k) & mask)
-                d1 = _difference(ring_hi, ring_lo, (j - k) & mask, (j - 2 * k) & mask)
-                d0 = _difference(ring_hi, ring_lo, (j - 2 * k) & mask, (j - 3 * k) & mask)
+                d2 = _difference(buf_hi, buf_lo, q, q - k)
+                d1 = _difference(buf_hi, buf_lo, q - k, q - 2 * k)
+                d0 = _difference(buf_hi, buf_lo, q - 2 * k, q - 3 * k)
                 term = (d2 - d1) - (d1 - d0)
-            _add(sums, comps, level, term * term)
-            counts[level] += 1
+            y = term * term - comp
+            tsum = total + y
+            comp = (tsum - total) - y
+            total = tsum
+            count += 1
+        sums[level], comps[level], counts[level] = total, comp, count
+        dcount[level], dsum[level] = dc, window
+    hist_hi[:] = buf_hi[c:]
+    hist_lo[:] = buf_lo[c:]
+    state[0] = p + c

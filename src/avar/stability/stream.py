@@ -4,8 +4,9 @@ For long-running monitoring of a clock or a sensor: feed chunks of any size
 with :meth:`Stream.update`, read the current deviations with
 :meth:`Stream.result` at any time. O(levels) work per sample, memory bounded
 by the largest tau (the last 2m or 3m phase points, as double-double numbers,
-and for MDEV/TDEV the last m second differences of each level), never by the
-length of the stream. The numbers equal the batch function's on the
+and for MDEV/TDEV the last m second differences of each level; an update
+works on a copy of that history followed by the chunk), never by the length
+of the stream. The numbers equal the batch function's on the
 concatenated data (to rounding, ~1e-12 relative).
 """
 
@@ -83,7 +84,7 @@ class Stream:
         self.statistic, self.data_type, self.confidence, self.alpha = statistic, data_type, float(confidence), fixed
         self.factors = grid_factors(taus, self.rate, 2**40, first_octave=0, context="of a stream")
         self._kind, span, self._k = STREAM_STATISTICS[statistic]
-        self._ring_hi = np.zeros(1 << (span * int(self.factors[-1])).bit_length())  # > span max(m), a power of 2
+        self._ring_hi = np.zeros(span * int(self.factors[-1]) + 1)  # the last span max(m) + 1 phase points
         self._ring_lo = np.zeros_like(self._ring_hi)
         self._state = np.array([1.0 if data_type == "freq" else 0.0, 0.0, 0.0])
         levels = self.factors.size
