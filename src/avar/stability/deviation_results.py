@@ -25,8 +25,11 @@ class Deviation:
     """One time-and-frequency stability deviation, level by level.
 
     Build it with :func:`avar.adev`, :func:`avar.oadev`, :func:`avar.mdev`,
-    :func:`avar.tdev`, :func:`avar.hdev`, :func:`avar.ohdev` or
-    :func:`avar.totdev`; the fields are read-only.
+    :func:`avar.tdev`, :func:`avar.hdev`, :func:`avar.ohdev`,
+    :func:`avar.totdev`, :func:`avar.pdev`, :func:`avar.mtie`,
+    :func:`avar.tierms`, :func:`avar.gcodev`, :func:`avar.three_cornered_hat`
+    or :class:`avar.Stream`; the fields are read-only. MTIE, TIE rms and
+    GCODEV carry no bounds (``edf``, ``lci``, ``uci`` NaN).
 
     Attributes
     ----------
@@ -48,7 +51,8 @@ class Deviation:
     lci, uci : ndarray
         Lower and upper chi-squared confidence bounds of the deviation.
     estimator : str
-        ``"adev"``, ``"oadev"``, ``"mdev"``, ``"tdev"``, ``"hdev"``, ``"ohdev"`` or ``"totdev"``.
+        The statistic's name: ``"adev"`` ... ``"totdev"``, or one of the registry
+        :data:`avar.stability.statistics.DEVIATION_STATISTICS` (and ``"gcodev"``).
     data_type : {"phase", "freq"}
         What the input held: phase (time error, s) or fractional frequency.
     rate : float
