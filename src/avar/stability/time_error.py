@@ -218,8 +218,10 @@ def pdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oct
 
         PVAR(tau) = 72 / ((N - 2m) m**4 tau**2) sum_{i=0}^{N-2m-1} [ sum_{k=0}^{m-1} ((m - 1) / 2 - k) (x_{i+k} - x_{i+k+m}) ]**2
 
-    for m >= 2, n = N - 2m terms, m = 1 .. (N - 1) / 2; at m = 1 the weights
-    vanish and PDEV is OADEV at tau0, as ``allantools.pdev``. Dimensionless.
+    for m >= 2, n = N - 2m terms, m = 1 .. (N - 1) / 2 (term i spans x_i ..
+    x_{i+2m-1}, so the last phase point is unused, as in Vernotte et al. 2020
+    and ``allantools.pdev``); at m = 1 the weights vanish and PDEV is OADEV
+    at tau0, as ``allantools.pdev``. Dimensionless.
     Like MDEV it falls as tau**-3/2 for white PM, but it spans 2 tau, as ADEV.
     O(N) per level (the inner sums by a recurrence, recomputed every m steps).
     The chi-squared bounds use the EDF of OADEV (same span and term count) for
