@@ -114,6 +114,21 @@ def bench_power_law(quick: bool) -> None:
               f"{np.mean(ratio):.3f} (levels {np.round(np.mean(ratio, axis=0), 2).tolist()})")
 
 
+def bench_pdev_edf(quick: bool) -> None:
+    """Empirical EDF of PDEV (2 mean**2 / variance over simulated series) against the one used for its bounds."""
+    from avar.stability.time_error import pdev_edf
+
+    n, seeds = 1024, (100 if quick else 300)
+    factors = 2 ** np.arange(0, 8)
+    print(f"\nPDEV EDF, N = {n}, {seeds} series per noise, m = {factors.tolist()}:")
+    for alpha in (2, 1, 0, -1, -2):
+        v = np.array([avar.pdev(avar.noise.power_law(alpha, n, seed=s), taus=factors.astype(float),
+                                alpha=alpha).variance for s in range(seeds)])
+        empirical = 2 * v.mean(0) ** 2 / v.var(0)
+        used = pdev_edf(np.full(factors.size, alpha), factors, n + 1)
+        print(f"  alpha = {alpha:+d}: empirical / used {np.round(empirical / used, 2).tolist()}")
+
+
 def main(quick: bool | None = None) -> None:
     if quick is None:
         parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -123,6 +138,7 @@ def main(quick: bool | None = None) -> None:
     bench_peers(quick)
     bench_stream(quick)
     bench_power_law(quick)
+    bench_pdev_edf(quick)
 
 
 if __name__ == "__main__":
