@@ -158,3 +158,21 @@ def test_noise_of_the_line_free_phase_is_the_deviation_familys():
             res = avar.tierms(data, data_type=data_type, taus="decade")
             expected = noise_exponents("oadev", data, data_type, 1.0, res.averaging_factors)
             assert res.alpha.tolist() == expected.tolist()
+
+
+def test_frequency_gaps_skip_the_windows_that_span_them():
+    rng = np.random.default_rng(13)
+    y = rng.standard_normal(90)
+    y[[20, 55]] = np.nan
+    x = np.concatenate(([0.0], np.cumsum(np.where(np.isnan(y), 0.0, y - np.nanmean(y)))))
+    for name in ("mtie", "tierms"):
+        res = getattr(avar, name)(y, data_type="freq", taus=[1, 3, 10], nan_policy="omit")
+        for m, dev, n in zip(res.averaging_factors, res.deviation, res.n):
+            m = int(m)
+            starts = [i for i in range(x.size - m) if not np.isnan(y[i : i + m]).any()]
+            if name == "mtie":
+                expected = max(np.ptp(x[i : i + m + 1]) for i in starts)
+            else:
+                expected = math.sqrt(np.mean([(x[i + m] - x[i]) ** 2 for i in starts]))
+            assert n == len(starts)
+            assert dev == pytest.approx(expected, rel=1e-9)

@@ -21,15 +21,15 @@ def _window_count(gaps, i, span, extra):
 
 
 @njit(cache=True)
-def mtie_levels(x, m, gaps, extra, fill_low, fill_high):
+def mtie_levels(x, m, gaps, extra):
     """Largest range max - min over every window of m + 1 consecutive phase points.
 
     The van Herk / Gil-Werman sliding extremum: with blocks of w = m + 1
     points, the prefix extremum ``g`` within each block and the suffix one
     ``h``, the window starting at i has max(h[i], g[i + w - 1]); three
-    comparisons per point and level. ``fill_low`` / ``fill_high``: ``x`` with
-    gaps set to -inf / +inf (they never win a max / min); windows with a gap
-    are skipped. Returns (mtie, count) per level (mtie NaN where count is 0).
+    comparisons per point and level. Windows with a gap are skipped (the
+    filled values inside them reach no result). Returns (mtie, count) per
+    level (mtie NaN where count is 0).
     """
     n = x.size
     out = np.full(m.size, np.nan)
@@ -42,16 +42,16 @@ def mtie_levels(x, m, gaps, extra, fill_low, fill_high):
         w = m[level] + 1
         for start in range(0, n, w):
             stop = min(start + w, n)
-            gmax[start] = fill_low[start]
-            gmin[start] = fill_high[start]
+            gmax[start] = x[start]
+            gmin[start] = x[start]
             for i in range(start + 1, stop):
-                gmax[i] = max(gmax[i - 1], fill_low[i])
-                gmin[i] = min(gmin[i - 1], fill_high[i])
-            hmax[stop - 1] = fill_low[stop - 1]
-            hmin[stop - 1] = fill_high[stop - 1]
+                gmax[i] = max(gmax[i - 1], x[i])
+                gmin[i] = min(gmin[i - 1], x[i])
+            hmax[stop - 1] = x[stop - 1]
+            hmin[stop - 1] = x[stop - 1]
             for i in range(stop - 2, start - 1, -1):
-                hmax[i] = max(hmax[i + 1], fill_low[i])
-                hmin[i] = min(hmin[i + 1], fill_high[i])
+                hmax[i] = max(hmax[i + 1], x[i])
+                hmin[i] = min(hmin[i + 1], x[i])
         best = -np.inf
         count = 0
         for i in range(n - w + 1):

@@ -86,9 +86,8 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
                                    f"with {n_phase} phase points)")
     phase, gaps, extra = prepared_phase(values, data_type, rate)
     if statistic == "mtie":
-        low = np.where(_missing_points(gaps, extra, phase.size), -np.inf, phase)
-        high = np.where(np.isneginf(low), np.inf, phase)
-        deviation, n = mtie_levels(phase, factors, gaps, extra, low, high)
+        # a window with a gap is skipped, so the filled values never reach a result
+        deviation, n = mtie_levels(phase, factors, gaps, extra)
         variance = deviation**2
     else:
         if statistic == "pdev":
@@ -162,17 +161,6 @@ def pdev_edf(alpha: np.ndarray, factors: np.ndarray, n_phase: int) -> np.ndarray
         edf[fits] = estimator_edf("mdev", alpha[fits], factors[fits], n_phase)
     edf[pm & ~fits] = 1.0
     return edf
-
-
-def _missing_points(gaps: np.ndarray, extra: int, n_phase: int) -> np.ndarray:
-    """Phase points that are missing (phase data) or next to a missing value (frequency data)."""
-    counts = np.diff(gaps)
-    if extra:
-        return counts > 0
-    missing = np.zeros(n_phase, dtype=bool)  # value j lies between phase points j and j + 1
-    missing[:-1] |= counts > 0
-    missing[1:] |= counts > 0
-    return missing
 
 
 def _line_free(phase: np.ndarray, gaps: np.ndarray, extra: int) -> np.ndarray:
