@@ -90,7 +90,8 @@ def bench_stream(quick: bool) -> None:
                 diff = f"{float(np.max(np.abs(stream.result().deviation / batch.deviation - 1))):.1e}"
             else:
                 diff = "-"
-            print(f"| {statistic} | {n:.0e} | {taus.size} | 65536 | {seconds / n * 1e9:.1f} | {diff} |", flush=True)
+            print(f"| {statistic} | {n:.0e} | {taus.size} | {n // (cuts.size + 1)} | {seconds / n * 1e9:.1f} | {diff} |",
+                  flush=True)
 
 
 def bench_power_law(quick: bool) -> None:
