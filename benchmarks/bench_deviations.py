@@ -33,6 +33,7 @@ import contextlib
 import io
 import warnings
 
+import bench_catalogue  # benchmarks/bench_catalogue.py
 import numpy as np
 from timing import median_time  # benchmarks/timing.py
 
@@ -124,6 +125,8 @@ def main() -> None:
         print(f"\nAcceptance (public function >= {TARGET:g}x the plain allantools call at N = {ACCEPTANCE_N:.0e}):")
         for estimator, ratio in public_ratio.items():
             print(f"  {estimator:7s} {ratio:5.2f}x  {'holds' if ratio >= TARGET else 'NOT MET'}")
+    print("\nThe rest of the catalogue (benchmarks/bench_catalogue.py):")
+    bench_catalogue.main(quick=args.quick)
 
 
 if __name__ == "__main__":

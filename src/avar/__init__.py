@@ -51,6 +51,20 @@ _EXPORTS = {
     "ohdev": "avar.stability.deviations",
     "totdev": "avar.stability.deviations",
     "Deviation": "avar.stability.deviation_results",
+    "mtie": "avar.stability.time_error",
+    "tierms": "avar.stability.time_error",
+    "pdev": "avar.stability.time_error",
+    "phase_to_frequency": "avar.stability.conversions",
+    "frequency_to_phase": "avar.stability.conversions",
+    "remove_drift": "avar.stability.conversions",
+    "Drift": "avar.stability.conversions",
+    "three_cornered_hat": "avar.stability.clock_pairs",
+    "ThreeCorneredHat": "avar.stability.clock_pairs",
+    "gcodev": "avar.stability.clock_pairs",
+    "Stream": "avar.stability.stream",
+    "psd": "avar.stability.spectrum",
+    "psd_to_deviation": "avar.stability.spectrum",
+    "PowerSpectrum": "avar.stability.spectrum",
     "avlr": "avar.fit.avlr",
     "AvlrResult": "avar.fit.results",
     "ImuAvlrResult": "avar.fit.results",
@@ -66,7 +80,7 @@ _EXPORTS = {
 }
 
 #: Public submodules reached as attributes (``avar.datasets.load(...)``).
-_SUBMODULES = {"datasets": "avar.io.datasets"}
+_SUBMODULES = {"datasets": "avar.io.datasets", "noise": "avar.models.noise"}
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES])
 

@@ -1,6 +1,6 @@
 """The ``avar`` command line: the parser and the exit codes.
 
-Subcommands (one module each): ``demo``, ``compute``, ``fit``, ``report``, ``datasets``.
+Subcommands (one module each): ``demo``, ``compute``, ``deviation``, ``fit``, ``report``, ``datasets``.
 Problems with the user's files end with a one-line message on stderr and exit
 code 1; usage errors with exit code 2. Nothing here computes: the subcommands
 read, call the library and write.
@@ -15,11 +15,11 @@ import sys
 import threading
 
 from avar._validation import cap_text, check_freq
-from avar.cli import compute, datasets, demo, fit, report
+from avar.cli import compute, datasets, demo, deviation, fit, report
 from avar.cli.common import InputFileError, UsageError
 from avar.cli.outputs import remove_pending
 
-SUBCOMMANDS = (demo, compute, fit, report, datasets)
+SUBCOMMANDS = (demo, compute, deviation, fit, report, datasets)
 SCALE_OPTIONS = frozenset(f"--{name}{suffix}" for name, _ in fit.PROCESSES for suffix in ("", "-gyro", "-acc"))
 #: Seconds between the main thread's checks for Ctrl-C while the worker runs.
 WAIT_STEP = 0.1

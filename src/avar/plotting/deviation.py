@@ -22,7 +22,6 @@ from avar.plotting.base import (
     new_axes,
     setup_log_axes,
 )
-from avar.stability.deviation_grids import LONG_NAMES
 from avar.stability.deviation_results import Deviation
 
 
@@ -100,6 +99,6 @@ def plot_deviation(
     if ylab is None:
         ylab = f"{x.name} $\\sigma_x(\\tau)$ (s)" if x.estimator == "tdev" else f"{x.name} $\\sigma_y(\\tau)$"
     xlab = r"Averaging time $\tau$ (s)" if xlab is None else xlab
-    title = f"{LONG_NAMES[x.estimator].capitalize()} ({x.data_type} data)" if main is None else main
+    title = f"{x.long_name.capitalize()} ({x.data_type} data)" if main is None else main
     finish(ax, xlab, ylab, title, legend, log_limits(*drawn))
     return fig

@@ -14,6 +14,7 @@ import pandas as pd
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
 from avar.stability.deviation_grids import ESTIMATORS, LONG_NAMES
+from avar.stability.statistics import DEVIATION_STATISTICS, EXTRA_LONG_NAMES, PAIR_STATISTICS
 
 #: Columns of :meth:`Deviation.summary`, in the order of Stable32's run table.
 SUMMARY_COLUMNS = ["Tau", "m", "N terms", "Alpha", "Min sigma", "Sigma", "Max sigma", "EDF"]
@@ -24,8 +25,11 @@ class Deviation:
     """One time-and-frequency stability deviation, level by level.
 
     Build it with :func:`avar.adev`, :func:`avar.oadev`, :func:`avar.mdev`,
-    :func:`avar.tdev`, :func:`avar.hdev`, :func:`avar.ohdev` or
-    :func:`avar.totdev`; the fields are read-only.
+    :func:`avar.tdev`, :func:`avar.hdev`, :func:`avar.ohdev`,
+    :func:`avar.totdev`, :func:`avar.pdev`, :func:`avar.mtie`,
+    :func:`avar.tierms`, :func:`avar.gcodev`, :func:`avar.three_cornered_hat`
+    or :class:`avar.Stream`; the fields are read-only. MTIE, TIE rms and
+    GCODEV carry no bounds (``edf``, ``lci``, ``uci`` NaN).
 
     Attributes
     ----------
@@ -47,7 +51,8 @@ class Deviation:
     lci, uci : ndarray
         Lower and upper chi-squared confidence bounds of the deviation.
     estimator : str
-        ``"adev"``, ``"oadev"``, ``"mdev"``, ``"tdev"``, ``"hdev"``, ``"ohdev"`` or ``"totdev"``.
+        The statistic's name: ``"adev"`` ... ``"totdev"``, or one of the registry
+        :data:`avar.stability.statistics.DEVIATION_STATISTICS` (and ``"gcodev"``).
     data_type : {"phase", "freq"}
         What the input held: phase (time error, s) or fractional frequency.
     rate : float
@@ -82,8 +87,9 @@ class Deviation:
         names = ("taus", "averaging_factors", "deviation", "variance", "n", "alpha", "edf", "lci", "uci")
         if len({len(getattr(self, name)) for name in names}) != 1:
             raise ValueError(f"{', '.join(names)} must have one length")
-        if self.estimator not in ESTIMATORS:
-            raise ValueError(f"estimator must be one of {ESTIMATORS}, got {short_repr(self.estimator)}")
+        known = (*ESTIMATORS, *DEVIATION_STATISTICS, *PAIR_STATISTICS)
+        if self.estimator not in known:
+            raise ValueError(f"estimator must be one of {sorted(set(known))}, got {short_repr(self.estimator)}")
         if self.data_type not in ("phase", "freq"):
             raise ValueError(f"data_type must be 'phase' or 'freq', got {short_repr(self.data_type)}")
         set_field(self, "rate", check_freq(self.rate, "rate"))
@@ -94,6 +100,11 @@ class Deviation:
     def name(self) -> str:
         """The estimator's upper-case name, e.g. ``"OADEV"``."""
         return self.estimator.upper()
+
+    @property
+    def long_name(self) -> str:
+        """The statistic's long name, e.g. ``"overlapping Allan deviation"``."""
+        return LONG_NAMES.get(self.estimator) or EXTRA_LONG_NAMES.get(self.estimator, self.estimator)
 
     def __len__(self) -> int:
         return len(self.taus)
@@ -124,7 +135,7 @@ class Deviation:
     def describe(self) -> str:
         """One line: estimator, input, rate, levels and confidence."""
         return (
-            f"{self.name} ({LONG_NAMES[self.estimator]}) of {self.n_samples} {self.data_type} samples "
+            f"{self.name} ({self.long_name}) of {self.n_samples} {self.data_type} samples "
             f"at {self.rate:g} Hz, {len(self)} levels, {self.confidence:.3g} confidence"
         )
 

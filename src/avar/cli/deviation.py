@@ -1,0 +1,116 @@
+"""``avar deviation``: Stable32-style tables of the deviation statistics of one column of a file.
+
+Every ``--stat NAME`` is looked up by name among the public deviation
+functions of ``avar`` (``getattr(avar, NAME)``); the accepted names are the
+registry :data:`avar.stability.statistics.DEVIATION_STATISTICS`, so a new
+statistic needs no change here.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pandas as pd
+
+from avar.cli.common import Progress, UsageError
+from avar.cli.outputs import plan_outputs, report
+from avar.stability.statistics import DEVIATION_STATISTICS
+
+#: Columns of the printed table, as Stable32's run table.
+TABLE_COLUMNS = ["AF", "Tau", "#", "Alpha", "Min Sigma", "Sigma", "Max Sigma"]
+
+
+def statistic_function(name: str):
+    """The public function of ``avar`` named ``name`` (one of the registry)."""
+    import avar
+
+    if name not in DEVIATION_STATISTICS:
+        raise UsageError(f"unknown statistic {name!r}; use one of {', '.join(DEVIATION_STATISTICS)}")
+    return getattr(avar, name)
+
+
+def table_of(result) -> pd.DataFrame:
+    """One row per level: AF (m), Tau, # (terms), Alpha, Min Sigma, Sigma, Max Sigma."""
+    return pd.DataFrame({"AF": result.averaging_factors, "Tau": result.taus, "#": result.n, "Alpha": result.alpha,
+                         "Min Sigma": result.lci, "Sigma": result.deviation, "Max Sigma": result.uci},
+                        columns=TABLE_COLUMNS)
+
+
+def format_run(result, source: str) -> str:
+    """The header line and the table, numbers as Stable32 prints them (4 significant digits, e-notation)."""
+    table = table_of(result)
+    text = table.to_string(index=False, na_rep="-",  # no bound (MTIE, TIE rms): a dash
+                           formatters={name: "{:.4e}".format for name in ("Tau", "Min Sigma", "Sigma", "Max Sigma")})
+    return f"{source}: {result.describe()}\n{text}"
+
+
+
+def _values(args: argparse.Namespace):
+    from avar.io.read import read
+
+    data = read(args.file, columns=args.column, freq=args.rate, time_unit=args.time_unit, gaps=args.gaps)
+    names = list(data.columns)
+    if len(names) != 1:
+        raise UsageError(f"{args.file} has {len(names)} data columns ({', '.join(names[:6])}); "
+                         "choose one with --column NAME")
+    rate = args.rate if args.rate is not None else data.freq
+    return names[0], data.columns[names[0]], float(rate)
+
+
+def run(args: argparse.Namespace) -> int:
+    stats = args.stat or ["oadev"]
+    functions = [statistic_function(name) for name in stats]
+    plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
+    progress = Progress()
+    progress(f"reading {args.file}")
+    column, values, rate = _values(args)
+    results = []
+    for name, function in zip(stats, functions):
+        progress(f"computing {name}")
+        results.append(function(values, rate=rate, data_type=args.data_type, taus=args.taus,
+                                confidence=args.confidence, nan_policy=args.nan_policy))
+    source = f"{Path(args.file).name} [{column}]"
+
+    def csv() -> str:
+        frames = [table_of(r).assign(Stat=r.name)[["Stat", *TABLE_COLUMNS]] for r in results]
+        return pd.concat(frames, ignore_index=True).to_csv(index=False)
+
+    def figure():
+        from avar.plotting.deviation import plot_deviation
+
+        fig = None
+        for k, result in enumerate(results):
+            fig = plot_deviation(result, colour=f"C{k}", main=f"{source}, {args.data_type} data",
+                                 ylab="Deviation", ax=None if fig is None else fig.axes[0])
+        return fig
+
+    written = plan.write(csv=csv, figure=figure)
+    progress("done")
+    report(written, "\n\n".join(format_run(r, source) for r in results))
+    return 0
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser(
+        "deviation", help="Stable32-style tables of ADEV, OADEV, MDEV, ... of one column of phase or frequency data")
+    parser.add_argument("file", help="CSV/TSV/text or .npy file of phase or frequency data")
+    parser.add_argument("--stat", action="append", metavar="NAME", choices=DEVIATION_STATISTICS,
+                        help=f"statistic (repeatable; default oadev): {', '.join(DEVIATION_STATISTICS)}")
+    parser.add_argument("--data-type", choices=["phase", "freq"], required=True,
+                        help="phase (time error, s) or fractional frequency data")
+    parser.add_argument("--rate", type=float, help="sampling rate in Hz (default: from a time column, else 1)")
+    parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help="tau grid")
+    parser.add_argument("--column", metavar="NAME", help="the data column (needed when there are several)")
+    parser.add_argument("--confidence", type=float, default=0.683, help="confidence of Min/Max Sigma (0.683)")
+    parser.add_argument("--nan-policy", choices=["raise", "omit"], default="raise",
+                        help="NaN (gaps) in the data: refuse, or skip the terms that touch them")
+    parser.add_argument("--time-unit", choices=["s", "ms", "us", "ns"], default=None,
+                        help="unit of a numeric time column (default: from its name, else s)")
+    parser.add_argument("--gaps", choices=["error", "ignore"], default="error",
+                        help="time steps > 1.5 median steps: refuse (default) or treat the samples as contiguous")
+    parser.add_argument("--output", metavar="CSV", help="write the tables to this CSV file ('-': stdout)")
+    parser.add_argument("--plot", metavar="PNG", help="write the figure (format from its extension)")
+    parser.add_argument("--force", action="store_true", help="replace existing --output / --plot files")
+    parser.set_defaults(handler=run)
+
