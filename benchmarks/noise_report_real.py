@@ -13,7 +13,8 @@ report is checked against a generator that shares none of its code:
 Scenarios (2 h at 200 Hz, rad/s), each over ``REPS`` seeds:
 
 (a) white + flicker + a visible random walk; (b) the same plus a Gauss-Markov
-term; (c) (a) quantized to an LSB of 0.4 sigma; (d) (a) with 3 % spikes, the
+term; (c) (a) quantized to an LSB of 0.4 sigma (rounding a rate sample adds white noise, so
+N's truth there is sqrt(N^2 + LSB^2 / (12 f))); (d) (a) with 3 % spikes, the
 report with and without ``robust=True``.
 
 For each term it prints the median |estimate / truth - 1|, the share of seeds
@@ -85,7 +86,8 @@ def row_of(report, process: str) -> dict:
     return table[table["Process"] == process].iloc[0].to_dict()
 
 
-def scenario(name: str, reps: int, make, robust: bool = False) -> None:
+def scenario(name: str, reps: int, make, robust: bool = False, truth: dict | None = None) -> None:
+    truth_of = dict(TRUTH, **(truth or {}))
     errors = {p: [] for p in TRUTH}
     covered = {p: [] for p in TRUTH}
     rw_ok, times, gm_err, gm_cov = [], [], [], []
@@ -96,7 +98,7 @@ def scenario(name: str, reps: int, make, robust: bool = False) -> None:
         kwargs = {"robust": True} if robust else {}
         report = avar.noise_report(x, gyro_units="rad/s", freq=FREQ, **kwargs)
         times.append(time.perf_counter() - start)
-        for process, truth in TRUTH.items():
+        for process, truth in truth_of.items():
             row = row_of(report, process)
             if row["Status"] == "present":
                 errors[process].append(abs(float(row["Value"]) / truth - 1))
@@ -179,7 +181,10 @@ def main() -> None:
     if "b" in chosen:
         scenario("b: gauss-markov added", reps, lambda rng: gyro(rng, gauss_markov=True))
     if "c" in chosen:
-        scenario(f"c: quantized, LSB {lsb:.3g} rad/s", reps, lambda rng: np.round(gyro(rng) / lsb) * lsb)
+        # rounding a rate sample adds white noise of variance LSB^2 / 12 per sample: N^2 + LSB^2 / (12 f)
+        white = math.sqrt(TRUTH["WN"] ** 2 + lsb**2 / (12 * FREQ))
+        scenario(f"c: quantized, LSB {lsb:.3g} rad/s (N with the rounding's white noise {white:.4g})", reps,
+                 lambda rng: np.round(gyro(rng) / lsb) * lsb, truth={"WN": white})
     if "d" in chosen:
         scenario("d: 3 % spikes, plain", reps, lambda rng: spiked(rng, gyro(rng)))
         try:
