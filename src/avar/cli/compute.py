@@ -22,7 +22,7 @@ from avar.cli.compute_many import (
     run_many,
     summary_of,
 )
-from avar.cli.outputs import plan_outputs, report
+from avar.cli.outputs import csv_text, plan_outputs, report
 from avar.io.progress import PROGRESS_VALUES
 
 __all__ = ["ReadOptions", "add_input_arguments", "add_parser", "allan_of", "compute_from_args", "figure_of", "load",
@@ -108,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
     progress = Progress()
     results = compute_from_args(args, progress)
     summary = summary_of(results)
-    written = plan.write(csv=lambda: summary.to_csv(index=False), figure=lambda: figure_of(results))
+    written = plan.write(csv=lambda: csv_text(summary), figure=lambda: figure_of(results))
     progress("done")
     report(written, format_table(summary))
     return 0

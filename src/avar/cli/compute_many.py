@@ -27,7 +27,7 @@ from typing import Any
 import pandas as pd
 
 from avar.cli.common import Progress, UsageError, format_table
-from avar.cli.outputs import plan_outputs, report
+from avar.cli.outputs import csv_text, plan_outputs, report
 
 __all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "compute_file", "compute_files",
            "figure_of", "load", "run_many", "summary_of"]
@@ -298,7 +298,7 @@ def run_many(args: argparse.Namespace) -> int:
 
         def figure():
             return figure_of_files(labels, results)
-    written = plan.write(csv=lambda: summary.to_csv(index=False), figure=figure)
+    written = plan.write(csv=lambda: csv_text(summary), figure=figure)
     progress("done")
     report(written, format_table(summary))
     return 0

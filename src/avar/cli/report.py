@@ -12,8 +12,8 @@ import sys
 from pathlib import Path
 from types import SimpleNamespace
 
-from avar.cli.common import InputFileError, Progress, UsageError
-from avar.cli.outputs import Written, check_output_path, plan_outputs, write_atomically
+from avar.cli.common import InputFileError, Progress, UsageError, confidence_alpha
+from avar.cli.outputs import check_output_path, csv_text, plan_outputs
 from avar.cli.outputs import report as print_outputs
 
 
@@ -45,6 +45,8 @@ def run(args: argparse.Namespace) -> int:
 
     inputs = [Path(args.file)]
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
+    if args.kalibr == "-":
+        raise UsageError("--kalibr writes a file; '-' (stdout) is only for --output (give e.g. imu.yaml)")
     kalibr = check_output_path("--kalibr", args.kalibr, inputs, args.force) if args.kalibr else None
     if kalibr is not None and any(isinstance(p, Path) and p.resolve() == kalibr.resolve()
                                   for p in (plan.csv, plan.figure)):
@@ -57,17 +59,26 @@ def run(args: argparse.Namespace) -> int:
     progress("fitting the noise terms")
     report = noise_report(recording, gyro_units=args.gyro_units, accel_units=args.accel_units,
                           gyro=args.gyro, accel=args.accel, alpha=args.alpha, name=Path(args.file).name)
-    files = []
+    extra = []
     if kalibr is not None:
-        import yaml
-
-        text = yaml.safe_dump(report.kalibr(), sort_keys=False, default_flow_style=False)
-        write_atomically(kalibr, text.encode("utf-8"))
-        files.append(str(kalibr))
-    written = plan.write(csv=lambda: report.table.to_csv(index=False), figure=report.plot)
+        extra.append((kalibr, lambda: kalibr_yaml(report.kalibr())))
+    # every output is rendered (the yaml, the table, the figure) before any is written
+    written = plan.write(csv=lambda: csv_text(report.table), figure=report.plot, extra=extra)
     progress("done")
-    print_outputs(Written(tuple(files) + written.files, written.stdout_csv), str(report))
+    print_outputs(written, str(report))
     return 0
+
+
+def kalibr_yaml(fields: dict) -> bytes:
+    """The Kalibr fields as YAML; a non-finite density is refused (Kalibr cannot read ``.nan``)."""
+    import math
+
+    import yaml
+
+    bad = [key for key, value in fields.items() if isinstance(value, float) and not math.isfinite(value)]
+    if bad:
+        raise InputFileError(f"the Kalibr field(s) {bad} are not finite numbers; nothing was written")
+    return yaml.safe_dump(fields, sort_keys=False, default_flow_style=False).encode("utf-8")
 
 
 def add_parser(commands) -> None:
@@ -86,7 +97,7 @@ def add_parser(commands) -> None:
                         help="unit of a numeric time column (default: from its name, else s)")
     report.add_argument("--gaps", choices=["error", "ignore"], default="error",
                         help="time steps > 1.5 median steps: refuse (default) or treat the samples as contiguous")
-    report.add_argument("--alpha", type=float, default=0.05, help="1 - confidence level of the intervals")
+    report.add_argument("--alpha", type=confidence_alpha, default=0.05, help="1 - confidence level of the intervals")
     report.add_argument("--kalibr", metavar="YAML", help="write a Kalibr imu.yaml")
     report.add_argument("--plot", metavar="PNG", help="write the report figure")
     report.add_argument("--output", metavar="CSV", help="write the table of terms")

@@ -103,24 +103,47 @@ def write_kalibr(report: Any, path: Any, force: bool = False, **overrides: Any) 
     """Write :func:`kalibr_fields` to ``path`` as YAML (PyYAML); returns the path.
 
     The file is written to a temporary file in the same directory and renamed,
-    so a failure never leaves a half-written ``imu.yaml``; an existing file is
-    refused unless ``force=True``.
+    so a failure never leaves a half-written ``imu.yaml``; its mode follows the
+    umask (0o666 & ~umask, as any file the user creates). An existing file is
+    refused unless ``force=True``, and only a regular file is ever replaced (a
+    directory, FIFO, device or symbolic link is refused). A density that is not
+    a finite number is refused (Kalibr cannot use ``.nan``). Errors name
+    ``path``, never the temporary file.
     """
+    import stat
+
     import yaml
 
     fields = kalibr_fields(report, **overrides)
+    bad = [key for key, value in fields.items() if isinstance(value, float) and not np.isfinite(value)]
+    if bad:
+        raise ValueError(f"the Kalibr field(s) {bad} are not finite numbers; give them explicitly (e.g. {bad[0]}=...)")
     target = Path(path)
-    if target.exists() and not force:
+    try:
+        info = os.lstat(target)
+    except FileNotFoundError:
+        info = None
+    if info is not None and not stat.S_ISREG(info.st_mode):
+        raise ValueError(f"path {str(target)!r} exists and is not a regular file (a directory, link, FIFO or "
+                         "device); give a file name")
+    if info is not None and not force:
         raise FileExistsError(f"{target} exists; pass force=True to overwrite it")
     if report.source is not None and target.resolve() == Path(report.source).resolve():
         raise ValueError(f"{target} is the input file; choose another path")
-    handle, temporary = tempfile.mkstemp(dir=target.parent if str(target.parent) else ".", suffix=".yaml.tmp")
+    text = yaml.safe_dump(fields, sort_keys=False, default_flow_style=False).encode("utf-8")
+    umask = os.umask(0)
+    os.umask(umask)
+    temporary = None
     try:
-        with os.fdopen(handle, "w", encoding="utf-8") as out:
-            yaml.safe_dump(fields, out, sort_keys=False, default_flow_style=False)
+        handle, temporary = tempfile.mkstemp(dir=target.parent if str(target.parent) else ".", prefix=".imu.",
+                                             suffix=".yaml.part")
+        with os.fdopen(handle, "wb") as out:
+            out.write(text)
+        os.chmod(temporary, 0o666 & ~umask)
         os.replace(temporary, target)
-    except BaseException:
-        if os.path.exists(temporary):
+    except OSError as error:
+        raise OSError(error.errno, f"{target}: cannot write the Kalibr yaml ({error.strerror})") from None
+    finally:
+        if temporary is not None and os.path.exists(temporary):
             os.unlink(temporary)
-        raise
     return target

@@ -48,22 +48,83 @@ def _partial_sum(block: np.ndarray, m: int, type: str, count: int) -> np.ndarray
     return av * (2.0 * count)
 
 
-def allan_variance_dask(array: Any, factors: Any, type: str = "mo") -> np.ndarray:
+#: Least samples per chunk of the chunk-by-chunk path: finer input chunks are merged (rechunked),
+#: so that the graph holds at most about N / MIN_CHUNK tasks per level.
+MIN_CHUNK = 1 << 22
+#: Most (chunk, level) tasks of one graph; a finer grid on a series larger than memory is refused.
+MAX_TASKS = 200_000
+#: A Dask array of at most this many bytes (and a quarter of the free memory) is computed into memory.
+IN_MEMORY_BYTES = 1 << 30
+
+
+def _free_memory() -> float:
+    try:
+        import os
+
+        return float(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return float("inf")
+
+
+def fits_in_memory(x: Any) -> bool:
+    """Whether the float64 copy of ``x`` fits comfortably in memory (<= :data:`IN_MEMORY_BYTES` and a
+    quarter of the free memory): then it is computed once and the NumPy kernels run on it."""
+    size = float(np.prod(x.shape)) * 8.0
+    return size <= min(IN_MEMORY_BYTES, _free_memory() / 4.0)
+
+
+def known_chunks(x: Any) -> Any:
+    """``x`` with its chunk sizes known (a Dask array from e.g. boolean indexing has NaN sizes:
+    they are computed, one pass over the data)."""
+    if any(np.isnan(size) for sizes in x.chunks for size in sizes):
+        x = x.compute_chunk_sizes()
+    return x
+
+
+def allan_variance_dask(array: Any, factors: Any, type: str = "mo", min_chunk: int | None = None) -> np.ndarray:
     """Allan variance of a 1-D or 2-D ``dask.array`` (time along axis 0), shape (C, L).
 
     Computed on whatever dask scheduler is active (threads, processes or a
-    ``distributed.Client``). The NumPy path and this one agree to ~1e-15
-    relative: each partial sum is the streaming kernel's exact result on a
-    sub-series, and the partial sums (all non-negative) are added in chunk
+    ``distributed.Client``). Chunks smaller than ``min_chunk`` samples (default
+    :data:`MIN_CHUNK`) are
+    merged first, so the graph is bounded whatever the input's chunks (at most
+    :data:`MAX_TASKS` tasks). Data so large that the sums overflow are scaled by
+    a power of two (exact) and computed again. The NumPy path and this one agree
+    to ~1e-15 relative: each partial sum is the streaming kernel's exact result
+    on a sub-series, and the partial sums (all non-negative) are added in chunk
     order.
     """
-    import dask
     import dask.array as da
 
     x = array if isinstance(array, da.Array) else da.from_array(np.asarray(array))
     if x.ndim == 1:
         x = x[:, None]
+    x = known_chunks(x)
+    min_chunk = MIN_CHUNK if min_chunk is None else min_chunk
+    if min(x.chunks[0]) < min_chunk and len(x.chunks[0]) > 1:
+        x = x.rechunk({0: max(min_chunk, max(x.chunks[0])), 1: -1})
     factors = np.asarray(factors, dtype=np.int64).reshape(-1)
+    tasks = len(x.chunks[0]) * factors.size
+    if tasks > MAX_TASKS:
+        raise ValueError(f"taus: {factors.size} levels on {len(x.chunks[0])} chunks make {tasks} tasks, more than "
+                         f"{MAX_TASKS}; give a coarser grid (taus='octave' or 'decade') for a series larger than memory")
+    out = _allan_of_chunks(x, factors, type)
+    valid = (factors >= 1) & (factors <= x.shape[0] // 2)
+    if np.isfinite(out[:, valid]).all():
+        return out
+    if not bool(da.isfinite(x).all().compute()):
+        raise ValueError("x (a Dask array) holds NaN or infinite values; fill or cut them, "
+                         "or compute it and use nan_policy='omit'")
+    big = float(da.max(abs(x)).compute())  # finite data whose sums overflow: scale by 2**-e and add 2e to AV's
+    exponent = int(np.frexp(big)[1])
+    out = _allan_of_chunks(x * 2.0 ** -exponent, factors, type)
+    with np.errstate(over="ignore"):
+        return out * 4.0 ** exponent
+
+
+def _allan_of_chunks(x: Any, factors: np.ndarray, type: str) -> np.ndarray:
+    import dask
+
     n, channels = int(x.shape[0]), int(x.shape[1])
     edges = np.concatenate(([0], np.cumsum(x.chunks[0])))
     bounds = [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
