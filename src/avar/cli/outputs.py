@@ -98,6 +98,10 @@ def check_output_path(option: str, text: str, inputs: Sequence[Path], force: boo
         raise UsageError(f"{option} writes a file; '-' (stdout) is not a file name here (give e.g. ./out)")
     path = Path(text)
     shown = display(text)
+    limit = _name_limit(path.parent)
+    if len(os.fsencode(path.name)) > limit:
+        raise UsageError(f"{option}: the file name is {len(os.fsencode(path.name))} bytes long, more than the "
+                         f"{limit} its folder allows; choose a shorter name")
     if path.is_dir() and not path.is_symlink():
         raise UsageError(f"{option} {shown} is a directory; give a file name, e.g. {display(str(path / 'out'))}")
     folder = path.parent
@@ -113,10 +117,6 @@ def check_output_path(option: str, text: str, inputs: Sequence[Path], force: boo
                          "even with --force: give a file name")
     if os.path.lexists(path) and not force:
         raise UsageError(f"{option} {shown} exists; pass --force to replace it, or choose another name")
-    limit = _name_limit(folder)
-    if len(os.fsencode(path.name)) > limit:
-        raise UsageError(f"{option}: the file name is {len(os.fsencode(path.name))} bytes long, more than the "
-                         f"{limit} its folder allows; choose a shorter name")
     if not os.access(folder, os.W_OK | os.X_OK):
         raise UsageError(f"{option} {shown}: the folder {display(str(folder))} is not writable; "
                          "choose another folder")

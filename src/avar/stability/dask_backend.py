@@ -17,6 +17,7 @@ Dask is imported inside the functions: this module imports without it.
 
 from __future__ import annotations
 
+import logging
 import sys
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
@@ -177,6 +178,21 @@ def allan_variance_files(
                           progress=progress, unit="series")
 
 
+class WorkerLost(RuntimeError):
+    """A task whose worker process died (killed, e.g. out of memory) as often as the scheduler allows."""
+
+
+def _raise_task_error(future: Any, item: Any) -> None:
+    """The task's own error, or :class:`WorkerLost` in one line when its worker kept dying."""
+    from distributed import KilledWorker
+
+    try:
+        future.result()
+    except KilledWorker:
+        raise WorkerLost(f"the worker process computing {item} died repeatedly (killed by the system, e.g. out "
+                         "of memory); compute it with fewer workers, or alone") from None
+
+
 @contextmanager
 def cluster_client(scheduler: Any = None, workers: int = 2, timeout: float | None = None) -> Iterator[Any]:
     """A ``distributed.Client``: ``scheduler`` itself (a Client, left open), one connected to an address
@@ -185,7 +201,8 @@ def cluster_client(scheduler: Any = None, workers: int = 2, timeout: float | Non
     from dask.distributed import Client, LocalCluster
 
     if scheduler is None:
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                          silence_logs=logging.CRITICAL) as cluster:
             with Client(cluster) as client:
                 yield client
     elif isinstance(scheduler, str):
@@ -229,7 +246,7 @@ def map_on_cluster(
         try:
             for future in as_completed(futures):
                 if future.status == "error":
-                    future.result()  # raises the task's error
+                    _raise_task_error(future, items[futures.index(future)])
                 if bar is not None:
                     bar.update(1)
             return client.gather(futures)
