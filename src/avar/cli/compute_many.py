@@ -38,6 +38,8 @@ SHOW_PROGRESS: bool | None = None
 #: Seconds to wait for the scheduler named by ``--scheduler``.
 CONNECT_TIMEOUT = 15.0
 ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+]*://)?(?:\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):\d{1,5}$")
+#: Silences the resource tracker's "leaked semaphore" warning after an interrupted cluster run.
+QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 DASK_MISSING = '--workers/--scheduler run on dask.distributed, which is not installed: pip install "avar[dask]"'
 
 
@@ -295,7 +297,8 @@ def run_many(args: argparse.Namespace) -> int:
     if args.workers is not None:
         args.workers = _capped_workers(args.workers, len(paths))
         # an interrupted run ends at once (os._exit): the cluster's semaphores are the system's to free
-        sys.warnoptions.append("ignore:resource_tracker:UserWarning")
+        if QUIET_TRACKER not in sys.warnoptions:
+            sys.warnoptions.append(QUIET_TRACKER)  # passed on to the resource tracker process
     progress = Progress()
     where = f"on {args.scheduler}" if args.scheduler else f"on {args.workers} local worker(s)"
     progress(f"computing {len(paths)} file(s) {where if on_cluster else 'one after the other'}")
