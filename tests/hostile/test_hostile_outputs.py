@@ -198,6 +198,12 @@ def test_control_characters_of_a_header_are_escaped_on_the_terminal(tmp_path, ca
     assert code == 0, err
     assert "\x1b" not in stdout + err and "\x07" not in stdout + err
     assert "\\x1b[2Jred\\x1b[0m" in stdout and "b\\x07ell" in stdout
+    named = tmp_path / "log\x1b[31m.csv"  # a file name with an escape: notes and errors escape it too
+    named.write_bytes(path.read_bytes())
+    for extra in ([], ["--column", "nope"]):
+        code, stdout, err = cli(capsys, "compute", named, *extra)
+        assert code == (1 if extra else 0), err
+        assert "\x1b" not in stdout + err and "log\\x1b[31m.csv" in stdout + err
 
 
 # --------------------------------------------------------------------------- usage errors: exit 2

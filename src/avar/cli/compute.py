@@ -12,7 +12,7 @@ import sys
 import threading
 from contextlib import contextmanager
 
-from avar.cli.common import Progress, format_table
+from avar.cli.common import Progress, format_table, printable
 from avar.cli.compute_many import (
     ReadOptions,
     add_cluster_arguments,
@@ -33,7 +33,7 @@ def read_from_args(args: argparse.Namespace):
     """The file named in ``args`` as a Recording or an IMU (``--gyro``/``--accel``, or a bag)."""
     data, notes = load(args.file, ReadOptions.from_args(args))
     for note in notes:
-        print(note, file=sys.stderr)
+        print(printable(note), file=sys.stderr)
     return data
 
 

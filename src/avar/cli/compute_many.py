@@ -27,7 +27,7 @@ from typing import Any
 
 import pandas as pd
 
-from avar.cli.common import InputFileError, Progress, UsageError, format_table
+from avar.cli.common import InputFileError, Progress, UsageError, format_table, printable
 from avar.cli.outputs import csv_text, plan_outputs, report
 
 __all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "compute_file", "compute_files",
@@ -306,7 +306,7 @@ def run_many(args: argparse.Namespace) -> int:
     computed = compute_files(paths, options, args.workers, args.scheduler, show)
     for _, notes in computed:
         for note in notes:
-            print(note, file=sys.stderr)
+            print(printable(note), file=sys.stderr)
     results = [res for res, _ in computed]
     if len(results) == 1:
         summary = summary_of(results[0])

@@ -16,7 +16,7 @@ import threading
 
 from avar._validation import cap_text, check_freq
 from avar.cli import compute, datasets, demo, fit, report
-from avar.cli.common import InputFileError, UsageError
+from avar.cli.common import InputFileError, UsageError, printable
 from avar.cli.outputs import remove_pending
 
 SUBCOMMANDS = (demo, compute, fit, report, datasets)
@@ -169,10 +169,10 @@ def main(argv: list[str] | None = None) -> int:
         _quiet_stdout()
         return 0
     except UsageError as error:
-        print(f"avar {args.command}: error: {error}", file=sys.stderr)
+        print(f"avar {args.command}: error: {printable(error)}", file=sys.stderr)
         return 2
     except (InputFileError, ValueError, TypeError, OSError, MemoryError) as error:
-        print(f"avar: error: {cap_text(str(error) or type(error).__name__)}", file=sys.stderr)
+        print(f"avar: error: {printable(cap_text(str(error) or type(error).__name__))}", file=sys.stderr)
         return 1
 
 

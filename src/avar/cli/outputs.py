@@ -384,11 +384,11 @@ def report(written: Written, text: str) -> None:
         sys.stdout.write(written.stdout_csv)
         sys.stdout.flush()
         for name in written.files:
-            print(f"Wrote {name}", file=sys.stderr)
+            print(f"Wrote {printable(name)}", file=sys.stderr)
         return
     print(text)
     for name in written.files:
-        print(f"Wrote {name}")
+        print(f"Wrote {printable(name)}")
     sys.stdout.flush()
 
 
