@@ -294,7 +294,7 @@ def rate_from_index(index: Any, what: str) -> float | None:
         return _rate_from_seconds(index.to_numpy(dtype=np.float64), what)
     if not isinstance(index, (pd.DatetimeIndex, pd.TimedeltaIndex)) or len(index) < 2:
         return None
-    steps = np.diff(index.to_numpy())  # in the index's own unit: a conversion to ns could overflow
+    steps = np.diff((index.tz_convert(None) if getattr(index, "tz", None) else index).to_numpy())  # own unit
     unit, count = np.datetime_data(steps.dtype)
     steps = steps.astype(np.int64)
     if np.any(steps <= 0):

@@ -126,6 +126,8 @@ def test_a_datetime64_seconds_index_with_400_year_steps():
     index = pd.DatetimeIndex(np.datetime64("1000-01-01T00:00:00", "s") + step * np.arange(8))
     result = avar.avar(pd.Series(X[:8], index=index), taus="all")
     np.testing.assert_allclose(result.levels, np.array([1, 2, 3, 4]) * (step / np.timedelta64(1, "s")), rtol=1e-15)
+    zoned = pd.date_range("2026-03-29", periods=X.size, freq="10ms", tz="Europe/Paris")  # tz-aware, across DST
+    assert avar.avar(pd.Series(X, index=zoned)).freq == avar.oadev(pd.Series(X, index=zoned)).rate == 100.0
 
 
 # --------------------------------------------------------------------------- magnitudes and bounds

@@ -54,9 +54,12 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
     x : array_like, pandas.Series, avar.IMU or dask.array.Array
         1-D real series (any real dtype, read in place; memory maps stream). A
         Series with a regular DatetimeIndex or TimedeltaIndex gives the
-        sampling rate when ``freq`` is omitted. A 1-D Dask array is computed
-        chunk by chunk on the active scheduler (a ``distributed.Client``
-        included), to the same values (see :mod:`avar.stability.dask_backend`).
+        sampling rate when ``freq`` is omitted. A 1-D Dask array that fits
+        in memory is computed once and handed to the NumPy path (whatever its
+        chunks: the graph never grows with them); a larger one is computed
+        chunk by chunk (chunks merged to at least 2**22 samples) on the active
+        scheduler (a ``distributed.Client`` included), to the same values (see
+        :mod:`avar.stability.dask_backend`).
     type : {"mo", "to"}
         Estimator.
     freq : float, optional
