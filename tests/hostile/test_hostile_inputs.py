@@ -137,9 +137,11 @@ def test_deviations_of_data_near_the_float64_limits(estimator):
     for scale in (2.0 ** -480, 2.0 ** 480):  # squares under- or overflow; the scaled computation is exact
         got = estimator(X[:512] * scale)
         np.testing.assert_allclose(got.deviation, base.deviation * scale, rtol=1e-12)
-    for scale in (1e-300, 1e300):  # the deviation fits float64, its variance does not: one clear error
-        with pytest.raises(ValueError, match="variance of data of magnitude .* is beyond the float64 range"):
-            estimator(X[:512] * scale)
+    tiny = estimator(X[:512] * 1e-300)  # the deviation is exact; its square rounds to 0 in float64
+    np.testing.assert_allclose(tiny.deviation / 1e-300, base.deviation, rtol=1e-12)
+    assert np.all(tiny.variance == 0.0) and np.all(tiny.lci <= tiny.deviation)
+    with pytest.raises(ValueError, match="variance of data of magnitude .* is beyond the float64 range"):
+        estimator(X[:512] * 1e300)  # the deviation fits float64, its variance cannot: one clear error
 
 
 def test_the_allan_variance_of_data_near_1e_300_is_an_error_not_zero():

@@ -70,7 +70,7 @@ def parse_scales(text: str) -> range | list[int]:
 
 
 def printable(text: object) -> str:
-    """``text`` with control and escape characters written as escapes, safe to print on a terminal.
+    r"""``text`` with control and escape characters written as escapes, safe to print on a terminal.
 
     Names read from a file (a header cell holding ``\x1b[2J``) are shown, never obeyed.
 

@@ -136,7 +136,10 @@ SCALE_LIMIT = 400
 
 def _scaled(values: np.ndarray, scanned: tuple, weigh: bool) -> tuple[np.ndarray, tuple, int]:
     """``values`` scaled by 2**-e to magnitude ~1 when near the float64 limits (squares of data near
-    1e-300 underflow to 0, of data near 1e300 overflow), with their scan and e (0: unscaled)."""
+    1e-300 underflow to 0, of data near 1e300 overflow), with their scan and e (0: unscaled).
+
+    The deviation is then exact; the variance is its square correctly rounded (0 or subnormal for
+    data near 1e-300), and a variance beyond the float64 maximum is an error."""
     big = max(abs(float(scanned[2])), abs(float(scanned[3])))
     if not np.isfinite(big) or big == 0 or 2.0 ** -SCALE_LIMIT < big < 2.0 ** SCALE_LIMIT:
         return values, scanned, 0
@@ -206,8 +209,8 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     deviation = np.ldexp(np.sqrt(variance), exponent)
     if exponent:
         with np.errstate(over="ignore", under="ignore"):
-            scaled, variance = variance, np.ldexp(variance, 2 * exponent)
-        if np.isinf(variance).any() or ((variance == 0) & (scaled > 0)).any():
+            variance = np.ldexp(variance, 2 * exponent)
+        if np.isinf(variance).any():  # an underflow is the correctly rounded variance (0 or subnormal)
             raise ValueError(f"the {estimator} variance of data of magnitude {2.0 ** exponent:.3g} is beyond the "
                              f"float64 range (the deviation reaches {deviation.max():.3g}); rescale the data, "
                              "e.g. to other units")

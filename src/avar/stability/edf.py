@@ -346,7 +346,7 @@ def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE
     with np.errstate(invalid="ignore", divide="ignore"):
         upper, lower = chdtri(edf, tail), 2.0 * gammaincinv(edf / 2.0, tail)  # chi2.isf, chi2.ppf (tail, edf)
         lci, uci = deviation * np.sqrt(edf / upper), deviation * np.sqrt(edf / lower)
-        return np.fmin(lci, deviation), np.fmax(uci, deviation)
+        return np.minimum(lci, deviation), np.maximum(uci, deviation)
 
 
 def _real_array(values: Any, name: str) -> np.ndarray:
