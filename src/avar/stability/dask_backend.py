@@ -123,18 +123,28 @@ def allan_variance_dask(array: Any, factors: Any, type: str = "mo", min_chunk: i
         return out * 4.0 ** exponent
 
 
+def _window_sum(blocks: list, offset: int, length: int, m: int, type: str, count: int) -> np.ndarray:
+    """:func:`_partial_sum` of the ``length`` samples from ``offset`` in the joined ``blocks``."""
+    joined = blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
+    return _partial_sum(np.ascontiguousarray(joined[offset : offset + length]), m, type, count)
+
+
 def _allan_of_chunks(x: Any, factors: np.ndarray, type: str) -> np.ndarray:
     import dask
 
     n, channels = int(x.shape[0]), int(x.shape[1])
     edges = np.concatenate(([0], np.cumsum(x.chunks[0])))
     bounds = [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
+    blocks = list(x.to_delayed().ravel())  # one delayed block per chunk: a window joins the blocks it spans
     tasks, owners = [], []
     for k, m in enumerate(map(int, factors)):
         if m < 1 or m > n // 2:
             continue
         for i, start, stop, count in _windows(n, bounds, m, type):
-            part = dask.delayed(_partial_sum)(x[start:stop], m, type, count)
+            first = int(np.searchsorted(edges, start, side="right")) - 1
+            last = int(np.searchsorted(edges, stop, side="left"))
+            part = dask.delayed(_window_sum)(blocks[first:last], start - int(edges[first]), stop - start, m, type,
+                                             count)
             tasks.append(part)
             owners.append((k, i, count))
     results = dask.compute(*tasks)
