@@ -294,16 +294,15 @@ def rate_from_index(index: Any, what: str) -> float | None:
         return _rate_from_seconds(index.to_numpy(dtype=np.float64), what)
     if not isinstance(index, (pd.DatetimeIndex, pd.TimedeltaIndex)) or len(index) < 2:
         return None
-    steps = np.diff(index.to_numpy()).astype("timedelta64[ns]").astype(np.int64)
-    step_ns = steps[0]
+    steps = np.diff((index.tz_convert(None) if getattr(index, "tz", None) else index).to_numpy())  # own unit
+    unit, count = np.datetime_data(steps.dtype)
+    steps = steps.astype(np.int64)
     if np.any(steps <= 0):
         raise ValueError(f"{what} has a time index that does not increase strictly; sort it or drop duplicate times")
-    if np.any(steps != step_ns):
-        raise ValueError(
-            f"{what} has an irregular time index (steps from {steps.min()} to {steps.max()} ns); "
-            "resample it to a regular grid or pass freq explicitly with positional data"
-        )
-    return 1e9 / float(step_ns)
+    if np.any(steps != steps[0]):
+        raise ValueError(f"{what} has an irregular time index (steps from {steps.min() * count} to "
+                         f"{steps.max() * count} {unit}); resample it to a regular grid or pass freq explicitly")
+    return 1.0 / (float(steps[0]) * (np.timedelta64(count, unit) / np.timedelta64(1, "s")))
 
 
 def native_values(array: np.ndarray) -> np.ndarray | None:

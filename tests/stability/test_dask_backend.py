@@ -22,7 +22,7 @@ def test_sixteen_chunks_match_numpy_path(type):
     x = 1e3 + np.cumsum(np.random.default_rng(1).standard_normal(n))
     factors = np.concatenate((octave(n), [3, 1000, 77_777]))
     want = allan_variance_columns(x, factors, type)
-    got = allan_variance_dask(da.from_array(x, chunks=n // 16), factors, type)
+    got = allan_variance_dask(da.from_array(x, chunks=n // 16), factors, type, min_chunk=1)
     np.testing.assert_allclose(got, want, rtol=1e-12)
 
 
@@ -31,7 +31,7 @@ def test_uneven_chunks_columns_and_invalid_factors():
     factors = np.array([1, 2, 7, 2502, 2501], dtype=np.int64)
     for type in ("mo", "to"):
         want = allan_variance_columns(x, factors, type)
-        got = allan_variance_dask(da.from_array(x, chunks=(777, 2)), factors, type)
+        got = allan_variance_dask(da.from_array(x, chunks=(777, 2)), factors, type, min_chunk=1)
         np.testing.assert_allclose(got, want, rtol=1e-12)
         assert np.isnan(got[:, 3]).all()
 
@@ -46,7 +46,7 @@ def test_local_cluster_threads_and_files(tmp_path):
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
         with distributed.Client(cluster) as client:
             x = np.load(paths[0])
-            got = allan_variance_dask(da.from_array(x, chunks=3000), octave(x.size), "mo")
+            got = allan_variance_dask(da.from_array(x, chunks=3000), octave(x.size), "mo", min_chunk=1)
             np.testing.assert_allclose(got, allan_variance_columns(x, octave(x.size), "mo"), rtol=1e-12)
             results = allan_variance_files(paths, np.load, octave, "to", scheduler=client, progress=False)
     for path, (factors, allan) in zip(paths, results):
@@ -68,10 +68,8 @@ def test_avar_of_a_dask_array_is_the_numpy_result():
         assert got.n == x.size and got.freq == 50.0
     y = x.copy()
     y[123_456] = np.nan
-    with pytest.raises(ValueError, match=r"x \(a Dask array\) holds NaN or infinite values"):
+    with pytest.raises(ValueError, match=r"x has 1 non-finite value"):  # in memory: the NumPy path's check
         avar.avar(da.from_array(y, chunks=100_000))
-    with pytest.raises(ValueError, match="a Dask array takes ci='r' and nan_policy='raise'"):
-        avar.avar(da.from_array(x, chunks=100_000), ci="chi2")
     with pytest.raises(ValueError, match="x must be 1-D"):
         avar.avar(da.ones((100, 2), chunks=50))
 
@@ -80,6 +78,23 @@ def test_avar_of_a_dask_array_is_the_numpy_result():
 def ten_million():
     """A random walk of 10**7 samples (80 MB): large values, levels growing over 7 decades."""
     return np.cumsum(np.random.default_rng(9).standard_normal(10**7))
+
+
+def test_larger_than_memory_path_refuses_non_finite_values_and_chi2(monkeypatch):
+    import avar
+    from avar.stability import dask_backend
+
+    monkeypatch.setattr(dask_backend, "IN_MEMORY_BYTES", 0)  # as for a series larger than memory
+    monkeypatch.setattr(dask_backend, "MIN_CHUNK", 1)
+    x = np.random.default_rng(8).standard_normal(100_000)
+    got = avar.avar(da.from_array(x, chunks=10_000))
+    np.testing.assert_allclose(got.allan, avar.avar(x).allan, rtol=1e-12)
+    y = x.copy()
+    y[23_456] = np.nan
+    with pytest.raises(ValueError, match=r"x \(a Dask array\) holds NaN or infinite values"):
+        avar.avar(da.from_array(y, chunks=10_000))
+    with pytest.raises(ValueError, match="a Dask array larger than memory takes ci='r' and nan_policy='raise'"):
+        avar.avar(da.from_array(x, chunks=10_000), ci="chi2")
 
 
 @pytest.mark.parametrize("type", ["mo", "to"])

@@ -11,7 +11,8 @@ import pandas as pd
 from avar._validation import short_repr
 from avar.io.read import InputFileError
 
-__all__ = ["FLOAT_FORMAT", "InputFileError", "Progress", "UsageError", "format_table", "parse_scales"]
+__all__ = ["FLOAT_FORMAT", "InputFileError", "Progress", "UsageError", "confidence_alpha", "display", "format_table",
+           "parse_scales", "printable", "replicates", "seed_number"]
 
 FLOAT_FORMAT = "{:.6g}".format
 
@@ -68,8 +69,77 @@ def parse_scales(text: str) -> range | list[int]:
     return [scale for piece in pieces for scale in piece]
 
 
+def printable(text: object) -> str:
+    r"""``text`` with control and escape characters written as escapes, safe to print on a terminal.
+
+    Names read from a file (a header cell holding ``\x1b[2J``) are shown, never obeyed.
+
+    >>> printable("gx\x1b[31m")
+    'gx\\x1b[31m'
+    """
+    text = str(text)
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
+
+
+#: Longest name or text cell shown in a printed table (the CSV output keeps it whole).
+CELL_LIMIT = 60
+
+
+def _cell(value: object) -> object:
+    if not isinstance(value, str):
+        return value
+    text = printable(value)
+    return text if len(text) <= CELL_LIMIT else f"{text[:CELL_LIMIT - 3]}..."
+
+
+def display(text: object, limit: int = 200) -> str:
+    """``repr(text)`` for a message, cut to about ``limit`` characters with the full length said."""
+    shown = repr(str(text))
+    if len(shown) <= limit:
+        return shown
+    return f"{shown[:limit]}... ({len(str(text))} characters)"
+
+
 def format_table(frame: pd.DataFrame, index: bool = False) -> str:
+    """The table as text for a terminal (names and text cells with control characters escaped)."""
+    frame = frame.rename(columns=_cell)
+    for name in frame.columns:
+        if frame[name].dtype.kind in "OSU" or str(frame[name].dtype) == "str":
+            frame[name] = frame[name].map(_cell)
     return frame.to_string(index=index, float_format=FLOAT_FORMAT)
+
+
+def confidence_alpha(text: str) -> float:
+    """``--alpha``: 1 - the confidence level, a number strictly between 0 and 1."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"expected 1 - the confidence level, a number in (0, 1) such as 0.05, "
+                                         f"got {short_repr(text)}")
+    return value
+
+
+def seed_number(text: str) -> int:
+    """``--seed``: a whole number >= 0."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {short_repr(text)}")
+    return value
+
+
+def replicates(text: str) -> int:
+    """``--B``: a whole number (its range is checked by the fit, which names the limit)."""
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number of replicates, got {short_repr(text)}") from None
 
 
 class UsageError(Exception):

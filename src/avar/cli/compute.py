@@ -12,7 +12,7 @@ import sys
 import threading
 from contextlib import contextmanager
 
-from avar.cli.common import Progress, format_table
+from avar.cli.common import Progress, format_table, printable
 from avar.cli.compute_many import (
     ReadOptions,
     add_cluster_arguments,
@@ -22,7 +22,7 @@ from avar.cli.compute_many import (
     run_many,
     summary_of,
 )
-from avar.cli.outputs import plan_outputs, report
+from avar.cli.outputs import csv_text, plan_outputs, report
 from avar.io.progress import PROGRESS_VALUES
 
 __all__ = ["ReadOptions", "add_input_arguments", "add_parser", "allan_of", "compute_from_args", "figure_of", "load",
@@ -33,7 +33,7 @@ def read_from_args(args: argparse.Namespace):
     """The file named in ``args`` as a Recording or an IMU (``--gyro``/``--accel``, or a bag)."""
     data, notes = load(args.file, ReadOptions.from_args(args))
     for note in notes:
-        print(note, file=sys.stderr)
+        print(printable(note), file=sys.stderr)
     return data
 
 
@@ -108,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
     progress = Progress()
     results = compute_from_args(args, progress)
     summary = summary_of(results)
-    written = plan.write(csv=lambda: summary.to_csv(index=False), figure=lambda: figure_of(results))
+    written = plan.write(csv=lambda: csv_text(summary), figure=lambda: figure_of(results))
     progress("done")
     report(written, format_table(summary))
     return 0

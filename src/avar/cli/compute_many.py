@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import os
 import re
 import sys
 from collections.abc import Iterable
@@ -26,8 +27,8 @@ from typing import Any
 
 import pandas as pd
 
-from avar.cli.common import Progress, UsageError, format_table
-from avar.cli.outputs import plan_outputs, report
+from avar.cli.common import InputFileError, Progress, UsageError, format_table, printable
+from avar.cli.outputs import csv_text, plan_outputs, report
 
 __all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "compute_file", "compute_files",
            "figure_of", "load", "run_many", "summary_of"]
@@ -37,6 +38,8 @@ SHOW_PROGRESS: bool | None = None
 #: Seconds to wait for the scheduler named by ``--scheduler``.
 CONNECT_TIMEOUT = 15.0
 ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+]*://)?(?:\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):\d{1,5}$")
+#: Silences the resource tracker's "leaked semaphore" warning after an interrupted cluster run.
+QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 DASK_MISSING = '--workers/--scheduler run on dask.distributed, which is not installed: pip install "avar[dask]"'
 
 
@@ -207,10 +210,13 @@ def compute_files(
             items = tqdm(paths, desc="computing", unit="file", file=sys.stderr)
         packed = [compute_file(path, options) for path in items]
     else:
-        from avar.stability.dask_backend import map_on_cluster
+        from avar.stability.dask_backend import WorkerLost, map_on_cluster
 
-        packed = map_on_cluster(compute_file, paths, options, scheduler=scheduler, workers=workers or 1,
-                                progress=progress, unit="file", timeout=CONNECT_TIMEOUT)
+        try:
+            packed = map_on_cluster(compute_file, paths, options, scheduler=scheduler, workers=workers or 1,
+                                    progress=progress, unit="file", timeout=CONNECT_TIMEOUT)
+        except WorkerLost as error:
+            raise InputFileError(str(error)) from None
     return [(unpack(result), notes) for result, notes in packed]
 
 
@@ -267,6 +273,16 @@ def _check_files(paths: list[str]) -> None:
         seen.add(key)
 
 
+def _capped_workers(asked: int, files: int) -> int:
+    """``--workers`` capped by the number of files (one task each) and of cores; a note says so."""
+    cores = os.cpu_count() or 1
+    workers = max(1, min(asked, files, cores))
+    if workers < asked:
+        print(f"--workers {asked}: {files} file(s) on {cores} core(s); starting {workers} worker process(es)",
+              file=sys.stderr)
+    return workers
+
+
 def run_many(args: argparse.Namespace) -> int:
     """``avar compute`` with several files, or with --workers/--scheduler."""
     options = ReadOptions.from_args(args)
@@ -278,6 +294,11 @@ def run_many(args: argparse.Namespace) -> int:
     paths = [str(path) for path in args.file]
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=paths, force=args.force)
     _check_files(paths)
+    if args.workers is not None:
+        args.workers = _capped_workers(args.workers, len(paths))
+        # an interrupted run ends at once (os._exit): the cluster's semaphores are the system's to free
+        if QUIET_TRACKER not in sys.warnoptions:
+            sys.warnoptions.append(QUIET_TRACKER)  # passed on to the resource tracker process
     progress = Progress()
     where = f"on {args.scheduler}" if args.scheduler else f"on {args.workers} local worker(s)"
     progress(f"computing {len(paths)} file(s) {where if on_cluster else 'one after the other'}")
@@ -285,7 +306,7 @@ def run_many(args: argparse.Namespace) -> int:
     computed = compute_files(paths, options, args.workers, args.scheduler, show)
     for _, notes in computed:
         for note in notes:
-            print(note, file=sys.stderr)
+            print(printable(note), file=sys.stderr)
     results = [res for res, _ in computed]
     if len(results) == 1:
         summary = summary_of(results[0])
@@ -298,7 +319,7 @@ def run_many(args: argparse.Namespace) -> int:
 
         def figure():
             return figure_of_files(labels, results)
-    written = plan.write(csv=lambda: summary.to_csv(index=False), figure=figure)
+    written = plan.write(csv=lambda: csv_text(summary), figure=figure)
     progress("done")
     report(written, format_table(summary))
     return 0

@@ -5,9 +5,17 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 
-from avar.cli.common import InputFileError, Progress, UsageError, parse_scales
+from avar.cli.common import (
+    InputFileError,
+    Progress,
+    UsageError,
+    confidence_alpha,
+    parse_scales,
+    replicates,
+    seed_number,
+)
 from avar.cli.compute import add_input_arguments, compute_from_args
-from avar.cli.outputs import plan_outputs, report
+from avar.cli.outputs import csv_text, plan_outputs, report
 
 PROCESSES = (("qn", "quantization noise"), ("wn", "white noise"), ("rw", "random walk"), ("dr", "drift"))
 SENSOR_SUFFIXES = {"Gyroscope": "gyro", "Accelerometer": "acc"}
@@ -79,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
 
         def figure():
             return fit.plot(deviation=args.deviation)
-    written = plan.write(csv=lambda: fit.summary().to_csv(), figure=figure)
+    written = plan.write(csv=lambda: csv_text(fit.summary(), index=True), figure=figure)
     progress("done")
     report(written, str(fit))
     return 0
@@ -100,7 +108,7 @@ def add_parser(commands) -> None:
     fit.add_argument("--deviation", action="store_true", help="plot the Allan deviation instead of the variance")
     fit.add_argument("--units", action="append", metavar="UNIT",
                      help="data unit: one for a series (deg/s), or gyro=UNIT / accel=UNIT for an IMU (repeatable)")
-    fit.add_argument("--B", type=int, default=100, help="bootstrap replicates (default 100)")
-    fit.add_argument("--alpha", type=float, default=0.05, help="1 - confidence level (default 0.05)")
-    fit.add_argument("--seed", type=int, default=None, help="seed of the bootstrap")
+    fit.add_argument("--B", type=replicates, default=100, help="bootstrap replicates (default 100)")
+    fit.add_argument("--alpha", type=confidence_alpha, default=0.05, help="1 - confidence level (default 0.05)")
+    fit.add_argument("--seed", type=seed_number, default=None, help="seed of the bootstrap")
     fit.set_defaults(handler=run)

@@ -16,7 +16,7 @@ import threading
 
 from avar._validation import cap_text, check_freq
 from avar.cli import compute, datasets, demo, deviation, fit, report
-from avar.cli.common import InputFileError, UsageError
+from avar.cli.common import InputFileError, UsageError, printable
 from avar.cli.outputs import remove_pending
 
 SUBCOMMANDS = (demo, compute, deviation, fit, report, datasets)
@@ -115,7 +115,37 @@ def _interrupted() -> int:
     return 130
 
 
+def _standard_streams() -> None:
+    """Give closed standard streams (``avar ... >&-``, ``2>&-``) a /dev/null in their place.
+
+    A closed descriptor 1 or 2 would otherwise be reused by the next file opened
+    (an output would receive the printed table), and Python leaves ``sys.stdout``
+    None (printing raises). The files are written all the same; what would have
+    been printed is discarded.
+    """
+    try:
+        import fcntl
+    except ImportError:  # not a POSIX system
+        return
+    for fd, name in ((1, "stdout"), (2, "stderr")):
+        try:
+            usable = fcntl.fcntl(fd, fcntl.F_GETFL) & os.O_ACCMODE != os.O_RDONLY
+        except OSError:  # closed
+            usable = False
+        if usable:
+            continue
+        try:
+            opened = os.open(os.devnull, os.O_WRONLY)
+        except OSError:
+            continue
+        if opened != fd:
+            os.dup2(opened, fd)
+            os.close(opened)
+        setattr(sys, name, open(fd, "w", closefd=False))
+
+
 def main(argv: list[str] | None = None) -> int:
+    _standard_streams()
     argv = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -140,10 +170,10 @@ def main(argv: list[str] | None = None) -> int:
         _quiet_stdout()
         return 0
     except UsageError as error:
-        print(f"avar {args.command}: error: {error}", file=sys.stderr)
+        print(f"avar {args.command}: error: {printable(error)}", file=sys.stderr)
         return 2
     except (InputFileError, ValueError, TypeError, OSError, MemoryError) as error:
-        print(f"avar: error: {cap_text(str(error) or type(error).__name__)}", file=sys.stderr)
+        print(f"avar: error: {printable(cap_text(str(error) or type(error).__name__))}", file=sys.stderr)
         return 1
 
 

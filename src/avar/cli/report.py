@@ -13,8 +13,8 @@ import sys
 from pathlib import Path
 from types import SimpleNamespace
 
-from avar.cli.common import InputFileError, Progress, UsageError
-from avar.cli.outputs import Written, check_output_path, plan_outputs, write_atomically
+from avar.cli.common import InputFileError, Progress, UsageError, confidence_alpha, printable
+from avar.cli.outputs import check_output_path, csv_text, plan_outputs
 from avar.cli.outputs import report as print_outputs
 
 
@@ -47,12 +47,15 @@ def run(args: argparse.Namespace) -> int:
 
     inputs = [Path(args.file)]
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
-    extra = {}
+    for option in ("--kalibr", "--curves", "--html"):
+        if getattr(args, option[2:]) == "-":
+            raise UsageError(f"{option} writes a file; '-' (stdout) is only for --output (give a file name)")
+    outputs = {}
     for option, value in (("--kalibr", args.kalibr), ("--curves", args.curves), ("--html", args.html)):
         if value is not None:
-            extra[option] = check_output_path(option, value, inputs, args.force)
+            outputs[option] = check_output_path(option, value, inputs, args.force)
     taken = [p.resolve() for p in (plan.csv, plan.figure) if isinstance(p, Path)]
-    for option, path in extra.items():
+    for option, path in outputs.items():
         if path.resolve() in taken:
             raise UsageError(f"{option} {str(path)!r} is also given for another output; give them different names")
         taken.append(path.resolve())
@@ -70,27 +73,28 @@ def run(args: argparse.Namespace) -> int:
     report = noise_report(recording, gyro_units=args.gyro_units, accel_units=args.accel_units,
                           gyro=args.gyro, accel=args.accel, alpha=args.alpha, name=Path(args.file).name,
                           from_bag=recording.bag, robust=args.robust)
-    contents = {}
-    if "--kalibr" in extra:
-        contents["--kalibr"] = report.kalibr_text(axis=args.kalibr_axis).encode("utf-8")
-    if "--curves" in extra:
-        contents["--curves"] = report.curves.to_csv(index=False).encode("utf-8")
-    files = []
-    if "--html" in extra:
-        from avar.plotting.html_report import report_html
-
-        command = " ".join(shlex.quote(word) for word in getattr(args, "command_line", None) or sys.argv)
-        contents["--html"] = report_html(report, command=command, source=str(args.file)).encode("utf-8")
-    for option, data in contents.items():
-        write_atomically(extra[option], data)
-        files.append(str(extra[option]))
-    written = plan.write(csv=lambda: report.table.to_csv(index=False),
-                         figure=lambda: report.plot(customary_axis=args.customary_axis))
+    renders = {
+        "--kalibr": lambda: report.kalibr_text(axis=args.kalibr_axis).encode("utf-8"),
+        "--curves": lambda: csv_text(report.curves).encode("utf-8"),
+        "--html": lambda: _html(report, args),
+    }
+    extra = [(path, renders[option]) for option, path in outputs.items()]
+    # every output is rendered (the yaml, the curves, the page, the table, the figure) before any is written
+    written = plan.write(csv=lambda: csv_text(report.table),
+                         figure=lambda: report.plot(customary_axis=args.customary_axis), extra=extra)
     progress("done")
     for warning in report.warnings:
-        print(f"warning: {warning}", file=sys.stderr)
-    print_outputs(Written(tuple(files) + written.files, written.stdout_csv), str(report))
+        print(f"warning: {printable(warning)}", file=sys.stderr)
+    print_outputs(written, str(report))
     return 0
+
+
+def _html(report, args: argparse.Namespace) -> bytes:
+    """The self-contained HTML page of the report, naming the command that made it."""
+    from avar.plotting.html_report import report_html
+
+    command = " ".join(shlex.quote(word) for word in getattr(args, "command_line", None) or sys.argv)
+    return report_html(report, command=command, source=str(args.file)).encode("utf-8")
 
 
 def add_parser(commands) -> None:
@@ -109,7 +113,7 @@ def add_parser(commands) -> None:
                         help="unit of a numeric time column (default: from its name, else s)")
     report.add_argument("--gaps", choices=["error", "ignore"], default="error",
                         help="time steps > 1.5 median steps: refuse (default) or treat the samples as contiguous")
-    report.add_argument("--alpha", type=float, default=0.05, help="1 - confidence level of the intervals")
+    report.add_argument("--alpha", type=confidence_alpha, default=0.05, help="1 - confidence level of the intervals")
     report.add_argument("--kalibr", metavar="YAML", help="write a Kalibr imu.yaml (a value for every key; "
                         "a term the data do not resolve gives its 95%% upper bound, marked in a comment)")
     report.add_argument("--kalibr-axis", choices=["max", "mean"], default="max",

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar._validation import as_series, check_count, check_real
+from avar._validation import as_series, check_real, check_replicates, check_seed
 from avar.fit.gmwm_model import ModelSpec, parse_model
 from avar.fit.gmwm_objective import WEIGHTINGS, equivalent_dof, fit_av
 from avar.fit.gmwm_results import GmwmResult, ImuGmwmResult
@@ -127,7 +127,8 @@ def gmwm(
         raise ValueError(f"weights must be one of {list(WEIGHTINGS)}, got {weights!r}")
     if not isinstance(ci, (bool, np.bool_)):
         raise TypeError(f"ci must be True or False, got {ci!r}")
-    replicates = check_count(B, "B", minimum=2)
+    replicates = check_replicates(B, "B", minimum=2)
+    seed = check_seed(seed)
     alpha = check_real(alpha, "alpha")
     if not 0.0 < alpha < 1.0:
         raise ValueError(f"alpha must be in (0, 1) (e.g. 0.05 for 95% intervals), got {alpha!r}")

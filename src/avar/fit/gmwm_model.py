@@ -163,6 +163,10 @@ class ModelSpec:
         return theta
 
 
+#: Processes a model may hold more than once (Gauss-Markov terms of different correlation times).
+REPEATABLE = ("AR1", "GM")
+
+
 def parse_model(model: Any) -> ModelSpec:
     """Validate the ``model`` argument of :func:`avar.gmwm` into a :class:`ModelSpec`.
 
@@ -204,6 +208,12 @@ def parse_model(model: Any) -> ModelSpec:
             starts.append(item)
         else:
             raise TypeError(f"model items must be process names, classes or instances; got {item!r}")
+    for cls in dict.fromkeys(classes):
+        count = classes.count(cls)
+        if count > 1 and cls.name not in REPEATABLE:
+            raise ValueError(f"model has {cls.name} {count} times: terms of one kind have the same Allan variance "
+                             f"shape, so only their sum is estimable (any split fits equally); give {cls.name} once "
+                             f"(only {' and '.join(REPEATABLE)} may repeat, with different correlation times)")
     return ModelSpec(tuple(classes), tuple(starts))
 
 

@@ -52,10 +52,11 @@ def axis_values(report: Any, kind: str, process: str) -> list[tuple[str, float, 
     rows = table[(table["Sensor"] == kind) & (table["Process"] == process)]
     out = []
     for _, row in rows.iterrows():
+        name = str(row.get("Channel", kind))
         if row["Status"] == "present":
-            out.append((str(row["Channel"]), float(row["Value"]), "present"))
+            out.append((name, float(row["Value"]), "present"))
         elif row["Status"] == "bound":
-            out.append((str(row["Channel"]), float(row["Upper"]), "bound"))
+            out.append((name, float(row["Upper"]), "bound"))
     return out
 
 
@@ -110,9 +111,11 @@ def kalibr_fields(report: Any, rostopic: str | None = None, update_rate: float |
                     raise ValueError(f"{key}: no {kind.lower()} axis has a value or a bound for it; "
                                      f"give {key}=... explicitly")
                 value = max(values) if axis == "max" else float(np.mean(values))
-            if not np.isfinite(value) or value < 0:
-                raise ValueError(f"{key} must be a finite density >= 0, got {value!r}")
             fields[key] = float(value)
+    bad = [key for key, value in fields.items() if not np.isfinite(value) or value < 0]
+    if bad:
+        raise ValueError(f"the Kalibr field(s) {bad} are not finite numbers >= 0; give them explicitly "
+                         f"(e.g. {bad[0]}=...)")
     fields = dict(sorted(fields.items(), key=lambda kv: list(FIELDS.values()).index(kv[0])))
     topic = rostopic if rostopic is not None else (report.topic or DEFAULT_TOPIC)
     if not isinstance(topic, str) or not topic:
@@ -151,7 +154,8 @@ def kalibr_text(report: Any, axis: str = "max", **overrides: Any) -> str:
 
     fields = kalibr_fields(report, axis=axis, **overrides)
     notes = kalibr_notes(report, axis=axis, **{k: v for k, v in overrides.items() if k in FIELDS.values()})
-    lines = [f"# IMU noise model written by avar from {report.name}: Kalibr's continuous-time densities (SI)"]
+    source = getattr(report, "name", None) or "a noise report"
+    lines = [f"# IMU noise model written by avar from {source}: Kalibr's continuous-time densities (SI)"]
     for key, value in fields.items():
         if key in notes:
             lines.append(f"# {notes[key]}")
@@ -163,22 +167,41 @@ def write_kalibr(report: Any, path: Any, force: bool = False, axis: str = "max",
     """Write :func:`kalibr_fields` to ``path`` as YAML (PyYAML); returns the path.
 
     The file is written to a temporary file in the same directory and renamed,
-    so a failure never leaves a half-written ``imu.yaml``; an existing file is
-    refused unless ``force=True``.
+    so a failure never leaves a half-written ``imu.yaml``; its mode follows the
+    umask (0o666 & ~umask, as any file the user creates). An existing file is
+    refused unless ``force=True``, and only a regular file is ever replaced (a
+    directory, FIFO, device or symbolic link is refused). A density that is not
+    a finite number is refused (Kalibr cannot use ``.nan``). Errors name
+    ``path``, never the temporary file.
     """
-    text = kalibr_text(report, axis=axis, **overrides)
+    import stat
+
+    text = kalibr_text(report, axis=axis, **overrides).encode("utf-8")  # densities checked finite there
     target = Path(path)
-    if target.exists() and not force:
+    try:
+        info = os.lstat(target)
+    except FileNotFoundError:
+        info = None
+    if info is not None and not stat.S_ISREG(info.st_mode):
+        raise ValueError(f"path {str(target)!r} exists and is not a regular file (a directory, link, FIFO or "
+                         "device); give a file name")
+    if info is not None and not force:
         raise FileExistsError(f"{target} exists; pass force=True to overwrite it")
     if report.source is not None and target.resolve() == Path(report.source).resolve():
         raise ValueError(f"{target} is the input file; choose another path")
-    handle, temporary = tempfile.mkstemp(dir=target.parent if str(target.parent) else ".", suffix=".yaml.tmp")
+    umask = os.umask(0)
+    os.umask(umask)
+    temporary = None
     try:
-        with os.fdopen(handle, "w", encoding="utf-8") as out:
+        handle, temporary = tempfile.mkstemp(dir=target.parent if str(target.parent) else ".", prefix=".imu.",
+                                             suffix=".yaml.part")
+        with os.fdopen(handle, "wb") as out:
             out.write(text)
+        os.chmod(temporary, 0o666 & ~umask)
         os.replace(temporary, target)
-    except BaseException:
-        if os.path.exists(temporary):
+    except OSError as error:
+        raise OSError(error.errno, f"{target}: cannot write the Kalibr yaml ({error.strerror})") from None
+    finally:
+        if temporary is not None and os.path.exists(temporary):
             os.unlink(temporary)
-        raise
     return target

@@ -18,6 +18,11 @@ def read_npy(path: Path) -> dict[str, np.ndarray]:
         array = np.load(path, mmap_mode="r", allow_pickle=False)
     except (OSError, ValueError) as error:
         raise ValueError(f"{path}: not a readable .npy array ({error})") from None
+    expected = getattr(array, "offset", 0) + array.nbytes
+    size = path.stat().st_size
+    if size > expected:
+        raise ValueError(f"{path}: {size - expected} byte(s) follow the {array.shape} array of the .npy file "
+                         "(a damaged or concatenated file); save one array per file (numpy.save)")
     if array.dtype.names:
         if array.ndim != 1:
             raise ValueError(f"{path}: a structured .npy array must be 1-D, got shape {array.shape}")

@@ -92,6 +92,22 @@ def _selection(names: Sequence[str], times: list[str], columns: Any, gyro: Any, 
     return wanted
 
 
+def _check_other_clocks(table: Any, times: list[str], freq: float, time_unit: Any, source: Path) -> None:
+    """Two time columns that give different rates (100 Hz ``time``, 50 Hz ``timestamp``) are a
+    conflict the user must settle (``time_column=`` or ``--freq``); one whose rate cannot be
+    read (a whole-seconds ``sec`` column) is not a clock of the samples and is left alone."""
+    for name in times[1:]:
+        try:
+            other = rate_of(table[name], name, time_unit, "ignore")["freq"]
+        except ValueError:
+            continue
+        if abs(other - freq) > 0.01 * freq:
+            raise InputFileError(
+                f"{source}: the time columns {clip(times[0], 60)} ({freq:.6g} Hz) and {clip(name, 60)} "
+                f"({other:.6g} Hz) disagree; name the clock of the samples (time_column=...) or pass the rate "
+                "(freq=..., --freq)")
+
+
 def read(
     path: str | os.PathLike,
     columns: str | Sequence[str] | None = None,
@@ -230,6 +246,8 @@ def read(
             timing = rate_of(table[times[0]], times[0], time_unit, gaps)
         except ValueError as error:
             raise InputFileError(f"{source}: {error}") from None
+        if time_column is None:
+            _check_other_clocks(table, times, timing["freq"], time_unit, source)
     else:
         timing = {"freq": 1.0, "rate_source": "no time column: 1 Hz, sample numbers as time"}
     if gyro is not None or accel is not None:

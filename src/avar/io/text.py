@@ -16,16 +16,20 @@ reported with their row and line (clipped to a readable length).
 
 from __future__ import annotations
 
+import codecs
 import csv
 import io
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-#: Bytes sniffed for the layout.
+#: Characters sniffed for the layout (the header and first data line are always read whole).
 SNIFF_BYTES = 1 << 16
+#: Longest line of a text table (characters): a longer one is refused, never cut.
+MAX_LINE_CHARS = 1 << 28
 #: Longest excerpt of a cell or line quoted in a message.
 QUOTE_LIMIT = 200
 _NUMBER = re.compile(r"[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?|[-+]?(nan|inf|infinity)", re.I)
@@ -45,8 +49,10 @@ class Layout:
     """What the first lines of a text table say about it."""
 
     def __init__(
-        self, separator: str, decimal: str, names: list[str], header_row: bool, skip: int, trailing: bool = False
+        self, separator: str, decimal: str, names: list[str], header_row: bool, skip: int, trailing: bool = False,
+        encoding: str = "utf-8-sig",
     ) -> None:
+        self.encoding = encoding  # "utf-8-sig", or UTF-16/32 found by detect_encoding
         self.separator = separator  # ";", "\t", ",", or r"\s+"
         self.trailing = trailing  # whether lines end with a separator (an empty last field)
         self.decimal = decimal
@@ -70,13 +76,54 @@ def _is_number(token: str) -> bool:
     return bool(_NUMBER.fullmatch(token.strip().strip('"')))
 
 
-def sniff(path: Path) -> Layout:
+def detect_encoding(path: Path) -> str:
+    """The text encoding of ``path``: from its byte-order mark, or UTF-16/32 recognised without one
+    by the zero bytes of ASCII text; else UTF-8 (a UTF-8 byte-order mark skipped)."""
+    with path.open("rb") as handle:
+        head = handle.read(4096)
+    if head.startswith((codecs.BOM_UTF32_LE, codecs.BOM_UTF32_BE)):
+        return "utf-32"
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return "utf-16"
+    size = len(head) - len(head) % 4
+    if size >= 4 and head.count(0, 0, size) >= size // 2:
+        zeros = [head[i:size:4].count(0) for i in range(4)]
+        quarter = size // 4
+        if zeros[1] == zeros[2] == zeros[3] == quarter and zeros[0] < quarter:
+            return "utf-32-le"
+        if zeros[0] == zeros[1] == zeros[2] == quarter and zeros[3] < quarter:
+            return "utf-32-be"
+        if zeros[1] + zeros[3] == 2 * quarter and zeros[0] + zeros[2] < 2 * quarter:
+            return "utf-16-le"
+        if zeros[0] + zeros[2] == 2 * quarter and zeros[1] + zeros[3] < 2 * quarter:
+            return "utf-16-be"
+        raise ValueError(f"{path}: not a text table (binary data: {head.count(0)} zero bytes in the first "
+                         f"{len(head)}); give a CSV/text file in UTF-8, UTF-16 or UTF-32, or a .npy array")
+    return "utf-8-sig"
+
+
+def _head(path: Path, encoding: str) -> list[str]:
+    """The first lines of the file: every comment line, the first two others whatever their
+    length (a 10,000-column header is read whole), then more up to :data:`SNIFF_BYTES`."""
+    lines: list[str] = []
+    total = content = 0
+    with path.open("r", encoding=encoding, errors="replace", newline="") as handle:
+        while line := handle.readline(MAX_LINE_CHARS + 1):
+            if len(line) > MAX_LINE_CHARS and not line.endswith(("\n", "\r")):
+                raise ValueError(f"{path}: line {len(lines) + 1} is longer than {MAX_LINE_CHARS:,} characters; "
+                                 "a text table's lines must be shorter")
+            lines.append(line.rstrip("\r\n"))
+            total += len(line)
+            if line.strip() and not line.lstrip().startswith("#"):
+                content += 1
+            if content >= 2 and total >= SNIFF_BYTES:
+                break
+    return lines
+
+
+def sniff(path: Path, encoding: str = "utf-8-sig") -> Layout:
     """The separator, decimal mark and header of a text table, from its first lines."""
-    with path.open("r", encoding="utf-8-sig", errors="replace", newline="") as handle:
-        sample = handle.read(SNIFF_BYTES)
-    lines = sample.splitlines()
-    if len(sample) == SNIFF_BYTES and len(lines) > 1:
-        lines = lines[:-1]  # the last line may be cut
+    lines = _head(path, encoding)
     skip, comment = 0, None
     while skip < len(lines) and (not lines[skip].strip() or lines[skip].lstrip().startswith("#")):
         if lines[skip].strip():
@@ -107,19 +154,22 @@ def sniff(path: Path) -> Layout:
                 names = candidate  # "# time gx gy" written by numpy.savetxt
         if names is None:
             names = [f"x{i + 1}" for i in range(len(tokens))] if len(tokens) > 1 else ["x"]
-        return Layout(separator, decimal, names, header_row=False, skip=skip, trailing=trailing)
+        return Layout(separator, decimal, names, header_row=False, skip=skip, trailing=trailing, encoding=encoding)
     names = [token.strip('"') for token in tokens]
-    return Layout(separator, decimal, names, header_row=True, skip=skip, trailing=trailing)
+    return Layout(separator, decimal, names, header_row=True, skip=skip, trailing=trailing, encoding=encoding)
 
 
 def _check_names(names: list[str], path: Path) -> list[str]:
     names = [str(name).strip() for name in names]
     empty = [i + 1 for i, name in enumerate(names) if not name]
     if empty:
-        raise ValueError(f"{path}: column(s) {empty} of the header have no name; name every column")
-    seen = {name for name in names if names.count(name) > 1}
+        raise ValueError(f"{path}: column(s) {clip(empty)} of the header have no name; name every column")
+    counts: dict[str, int] = {}
+    for name in names:
+        counts[name] = counts.get(name, 0) + 1
+    seen = sorted(name for name, count in counts.items() if count > 1)
     if seen:
-        raise ValueError(f"{path}: duplicate column names {sorted(seen)} in the header; names must be distinct")
+        raise ValueError(f"{path}: duplicate column names {clip(seen)} in the header; names must be distinct")
     return names
 
 
@@ -136,6 +186,19 @@ def count_lines(path: Path) -> int:
         while block := handle.read(_COUNT_BLOCK):
             count += block.count(b"\n")
     return count
+
+
+def _column_arrays(chunk: pd.DataFrame):
+    """(name, array) of every column; the numeric columns of one dtype in one pass (a 10**6-column
+    table would spend minutes in a per-column lookup)."""
+    dtypes = chunk.dtypes.to_numpy()
+    numeric = np.array([getattr(dtype, "kind", "O") in "iuf" for dtype in dtypes], dtype=bool)
+    for dtype in {dtype for dtype, keep in zip(dtypes, numeric) if keep}:
+        chosen = np.flatnonzero(numeric & (dtypes == dtype))
+        block = chunk.iloc[:, chosen].to_numpy(dtype=dtype)
+        yield from zip(chunk.columns[chosen], block.T)
+    for j in np.flatnonzero(~numeric):
+        yield chunk.columns[j], chunk.iloc[:, j].to_numpy()
 
 
 class _Columns:
@@ -163,8 +226,9 @@ class _Columns:
                 grown = np.empty(self.capacity, dtype=array.dtype)
                 grown[: self.n] = array[: self.n]
                 self.arrays[name] = grown
-        for name in chunk.columns:
-            values = chunk[name].to_numpy()
+        arrays = dict(_column_arrays(chunk))
+        for name in chunk.columns:  # in the file's order
+            values = arrays[name]
             kind = self._kind(values)
             target = self.arrays.get(name)
             if target is None:
@@ -200,7 +264,7 @@ def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[d
     ``stream`` (the opened file, e.g. wrapped by a progress bar) is read instead of
     ``path`` when given.
     """
-    layout = sniff(path)
+    layout = sniff(path, detect_encoding(path))
     names = _check_names(layout.names, path)
     extra = "\0trailing separator"
     columns = _Columns(count_lines(path) + 1 - layout.skip)
@@ -214,11 +278,12 @@ def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[d
             skiprows=layout.skip + (1 if layout.header_row else 0),
             index_col=False,
             engine="c",
-            encoding="utf-8-sig",
+            encoding=layout.encoding,
             skip_blank_lines=False,  # a blank line inside the data is a missing sample, not nothing
             quotechar='"',
             chunksize=CHUNK_ROWS,
-        ) as chunks:
+        ) as chunks, warnings.catch_warnings():
+            warnings.simplefilter("error", pd.errors.ParserWarning)  # pandas would drop the extra fields
             for chunk in chunks:
                 if layout.trailing:
                     spill = chunk[extra].notna().to_numpy()
@@ -233,6 +298,9 @@ def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[d
                 columns.add(chunk)
     except pd.errors.EmptyDataError:
         raise ValueError(f"{path}: the file holds a header but no data") from None
+    except pd.errors.ParserWarning:
+        raise ValueError(f"{path}: a line holds more values than the header's {len(names)} columns; every line "
+                         "must have the same number of columns") from None
     except (pd.errors.ParserError, UnicodeDecodeError) as error:
         message = clip(str(error).splitlines()[0] if str(error) else type(error).__name__)
         raise ValueError(f"{path}: not a readable CSV/text table ({message})") from None

@@ -147,7 +147,11 @@ class NoiseModel:
         n = check_count(n, "n")
         replicates = check_count(replicates, "replicates")
         out = np.empty((replicates, n))
-        self.simulate_into(out, np.random.default_rng(check_seed(seed)))
+        with np.errstate(over="ignore", invalid="ignore"):
+            self.simulate_into(out, np.random.default_rng(check_seed(seed)))
+        if not np.isfinite(out).all():  # e.g. DR(omega=1e306): omega t passes the float64 limit
+            raise ValueError(f"the simulation of {self!r} overflows float64 within {n} samples; rescale the "
+                             "model's parameters (e.g. other units) or simulate fewer samples")
         return out
 
     def simulate_into(self, out: np.ndarray, rng: np.random.Generator) -> None:

@@ -22,6 +22,9 @@ IMPLIED_COLOUR = "#F47F24"
 PROCESS_COLOURS = {"WN": "#2CA02C", "QN": "#9467BD", "RW": "#D62728", "DR": "#8C564B"}
 #: Default title of single plots.
 DEFAULT_TITLE = "Allan Variance Representation"
+#: Most entries of a legend (the last says how many series it leaves out), and longest label shown.
+LEGEND_ENTRIES = 20
+LEGEND_LABEL = 60
 #: Accepted legend positions: matplotlib names, and R names mapped to them.
 LEGEND_POSITIONS = {
     **{name: name for name in (
@@ -249,7 +252,16 @@ def finish(ax: Axes, xlab: str, ylab: str, main: str | None, legend: str | None,
     if limits is not None:
         ax.set_ylim(*limits)
     if legend is not None:
-        ax.legend(loc=legend, fontsize="small", framealpha=0.9)
+        handles, labels = ax.get_legend_handles_labels()
+        labels = [label if len(label) <= LEGEND_LABEL else f"{label[:LEGEND_LABEL - 3]}..." for label in labels]
+        if len(handles) > LEGEND_ENTRIES:  # 400 series would hide the plot: the first ones, and a count
+            from matplotlib.lines import Line2D
+
+            rest = len(handles) - LEGEND_ENTRIES + 1
+            handles = handles[: LEGEND_ENTRIES - 1] + [Line2D([], [], linestyle="none")]
+            labels = labels[: LEGEND_ENTRIES - 1] + [f"... and {rest} more (legend capped at {LEGEND_ENTRIES})"]
+        if handles:
+            ax.legend(handles, labels, loc=legend, fontsize="small", framealpha=0.9)
 
 
 # --------------------------------------------------------------------------- public plots

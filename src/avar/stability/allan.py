@@ -54,9 +54,12 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
     x : array_like, pandas.Series, avar.IMU or dask.array.Array
         1-D real series (any real dtype, read in place; memory maps stream). A
         Series with a regular DatetimeIndex or TimedeltaIndex gives the
-        sampling rate when ``freq`` is omitted. A 1-D Dask array is computed
-        chunk by chunk on the active scheduler (a ``distributed.Client``
-        included), to the same values (see :mod:`avar.stability.dask_backend`).
+        sampling rate when ``freq`` is omitted. A 1-D Dask array that fits
+        in memory is computed once and handed to the NumPy path (whatever its
+        chunks: the graph never grows with them); a larger one is computed
+        chunk by chunk (chunks merged to at least 2**22 samples) on the active
+        scheduler (a ``distributed.Client`` included), to the same values (see
+        :mod:`avar.stability.dask_backend`).
     type : {"mo", "to"}
         Estimator.
     freq : float, optional
@@ -192,23 +195,22 @@ def _is_dask_array(x: Any) -> bool:
 
 
 def _dask_allan_variance(x: Any, freq: Any, type: str, taus: Any, band: tuple, nan_policy: str) -> AllanVariance:
-    """A 1-D Dask array, chunk by chunk on the active scheduler (:mod:`avar.stability.dask_backend`)."""
-    from avar.stability.dask_backend import allan_variance_dask
+    """A 1-D Dask array: computed into memory and handed to the NumPy path when it fits
+    (:func:`avar.stability.dask_backend.fits_in_memory`), else chunk by chunk on the active
+    scheduler with chunks of at least :data:`~avar.stability.dask_backend.MIN_CHUNK` samples
+    (:mod:`avar.stability.dask_backend`): the task graph stays bounded whatever the input's chunks."""
+    from avar.stability.dask_backend import allan_variance_dask, fits_in_memory, known_chunks
 
-    if band[0] != "r" or nan_policy != "raise":
-        raise ValueError("a Dask array takes ci='r' and nan_policy='raise' (noise identification and gaps need "
-                         "the series in memory); compute it first, e.g. avar.avar(x.compute(), ci='chi2')")
     if x.ndim != 1:
         raise ValueError(f"x must be 1-D, got a Dask array of shape {x.shape}")
     check_numeric_dtype(np.empty(0, dtype=x.dtype), "x")
+    x = known_chunks(x)
+    if fits_in_memory(x):
+        return avar(np.asarray(x.compute()), type=type, freq=freq, taus=taus, ci=band[0], confidence=band[1],
+                    nan_policy=nan_policy)
+    if band[0] != "r" or nan_policy != "raise":
+        raise ValueError("a Dask array larger than memory takes ci='r' and nan_policy='raise' (noise "
+                         "identification and gaps need the series in memory)")
     check_length(int(x.shape[0]), "x")
     rate = 1.0 if freq is None else check_freq(freq)
-
-    def checked(data: Any, factors: np.ndarray, type: str) -> np.ndarray:
-        allan = allan_variance_dask(data, factors, type)
-        if not np.isfinite(allan).all():  # a non-finite sample makes every level it touches non-finite
-            raise ValueError("x (a Dask array) holds NaN or infinite values; fill or cut them, "
-                             "or compute it and use nan_policy='omit'")
-        return allan
-
-    return allan_variance_table(x[:, None], (None,), rate, type, taus, band, columns=checked)[None]
+    return allan_variance_table(x[:, None], (None,), rate, type, taus, band, columns=allan_variance_dask)[None]

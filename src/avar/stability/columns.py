@@ -32,4 +32,11 @@ def allan_variance_columns(data: np.ndarray, factors: np.ndarray, type: str) -> 
         for j in range(data.shape[1]):
             check_finite(data[:, j], "x" if data.shape[1] == 1 else f"column {j}")
         raise ValueError("the Allan variance overflows float64; rescale the data, e.g. to other units")
+    if (allan < np.finfo(np.float64).tiny).any():  # 0 or subnormal: a constant column, or squares that underflow
+        for j in range(data.shape[1]):
+            column = data[:, j]
+            low, high = float(column.min()), float(column.max())
+            if high > low and (allan[j] < np.finfo(np.float64).tiny).any() and max(abs(low), abs(high)) < 2.0 ** -400:
+                raise ValueError(f"the Allan variance of data of magnitude {max(abs(low), abs(high)):.3g} is below "
+                                 "the float64 range (its squares underflow); rescale the data, e.g. to other units")
     return allan

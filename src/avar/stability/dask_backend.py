@@ -17,6 +17,7 @@ Dask is imported inside the functions: this module imports without it.
 
 from __future__ import annotations
 
+import logging
 import sys
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
@@ -48,31 +49,102 @@ def _partial_sum(block: np.ndarray, m: int, type: str, count: int) -> np.ndarray
     return av * (2.0 * count)
 
 
-def allan_variance_dask(array: Any, factors: Any, type: str = "mo") -> np.ndarray:
+#: Least samples per chunk of the chunk-by-chunk path: finer input chunks are merged (rechunked),
+#: so that the graph holds at most about N / MIN_CHUNK tasks per level.
+MIN_CHUNK = 1 << 22
+#: Most (chunk, level) tasks of one graph; a finer grid on a series larger than memory is refused.
+MAX_TASKS = 200_000
+#: A Dask array of at most this many bytes (and a quarter of the free memory) is computed into memory.
+IN_MEMORY_BYTES = 1 << 30
+
+
+def _free_memory() -> float:
+    try:
+        import os
+
+        return float(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return float("inf")
+
+
+def fits_in_memory(x: Any) -> bool:
+    """Whether the float64 copy of ``x`` fits comfortably in memory (<= :data:`IN_MEMORY_BYTES` and a
+    quarter of the free memory): then it is computed once and the NumPy kernels run on it."""
+    size = float(np.prod(x.shape)) * 8.0
+    return size <= min(IN_MEMORY_BYTES, _free_memory() / 4.0)
+
+
+def known_chunks(x: Any) -> Any:
+    """``x`` with its chunk sizes known (a Dask array from e.g. boolean indexing has NaN sizes:
+    they are computed, one pass over the data)."""
+    if any(np.isnan(size) for sizes in x.chunks for size in sizes):
+        x = x.compute_chunk_sizes()
+    return x
+
+
+def allan_variance_dask(array: Any, factors: Any, type: str = "mo", min_chunk: int | None = None) -> np.ndarray:
     """Allan variance of a 1-D or 2-D ``dask.array`` (time along axis 0), shape (C, L).
 
     Computed on whatever dask scheduler is active (threads, processes or a
-    ``distributed.Client``). The NumPy path and this one agree to ~1e-15
-    relative: each partial sum is the streaming kernel's exact result on a
-    sub-series, and the partial sums (all non-negative) are added in chunk
+    ``distributed.Client``). Chunks smaller than ``min_chunk`` samples (default
+    :data:`MIN_CHUNK`) are
+    merged first, so the graph is bounded whatever the input's chunks (at most
+    :data:`MAX_TASKS` tasks). Data so large that the sums overflow are scaled by
+    a power of two (exact) and computed again. The NumPy path and this one agree
+    to ~1e-15 relative: each partial sum is the streaming kernel's exact result
+    on a sub-series, and the partial sums (all non-negative) are added in chunk
     order.
     """
-    import dask
     import dask.array as da
 
     x = array if isinstance(array, da.Array) else da.from_array(np.asarray(array))
     if x.ndim == 1:
         x = x[:, None]
+    x = known_chunks(x)
+    min_chunk = MIN_CHUNK if min_chunk is None else min_chunk
+    if min(x.chunks[0]) < min_chunk and len(x.chunks[0]) > 1:
+        x = x.rechunk({0: max(min_chunk, max(x.chunks[0])), 1: -1})
     factors = np.asarray(factors, dtype=np.int64).reshape(-1)
+    tasks = len(x.chunks[0]) * factors.size
+    if tasks > MAX_TASKS:
+        raise ValueError(f"taus: {factors.size} levels on {len(x.chunks[0])} chunks make {tasks} tasks, more than "
+                         f"{MAX_TASKS}; give a coarser grid (taus='octave' or 'decade') for a series larger than memory")
+    out = _allan_of_chunks(x, factors, type)
+    valid = (factors >= 1) & (factors <= x.shape[0] // 2)
+    if np.isfinite(out[:, valid]).all():
+        return out
+    if not bool(da.isfinite(x).all().compute()):
+        raise ValueError("x (a Dask array) holds NaN or infinite values; fill or cut them, "
+                         "or compute it and use nan_policy='omit'")
+    big = float(da.max(abs(x)).compute())  # finite data whose sums overflow: scale by 2**-e and add 2e to AV's
+    exponent = int(np.frexp(big)[1])
+    out = _allan_of_chunks(x * 2.0 ** -exponent, factors, type)
+    with np.errstate(over="ignore"):
+        return out * 4.0 ** exponent
+
+
+def _window_sum(blocks: list, offset: int, length: int, m: int, type: str, count: int) -> np.ndarray:
+    """:func:`_partial_sum` of the ``length`` samples from ``offset`` in the joined ``blocks``."""
+    joined = blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
+    return _partial_sum(np.ascontiguousarray(joined[offset : offset + length]), m, type, count)
+
+
+def _allan_of_chunks(x: Any, factors: np.ndarray, type: str) -> np.ndarray:
+    import dask
+
     n, channels = int(x.shape[0]), int(x.shape[1])
     edges = np.concatenate(([0], np.cumsum(x.chunks[0])))
     bounds = [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
+    blocks = list(x.to_delayed().ravel())  # one delayed block per chunk: a window joins the blocks it spans
     tasks, owners = [], []
     for k, m in enumerate(map(int, factors)):
         if m < 1 or m > n // 2:
             continue
         for i, start, stop, count in _windows(n, bounds, m, type):
-            part = dask.delayed(_partial_sum)(x[start:stop], m, type, count)
+            first = int(np.searchsorted(edges, start, side="right")) - 1
+            last = int(np.searchsorted(edges, stop, side="left"))
+            part = dask.delayed(_window_sum)(blocks[first:last], start - int(edges[first]), stop - start, m, type,
+                                             count)
             tasks.append(part)
             owners.append((k, i, count))
     results = dask.compute(*tasks)
@@ -116,6 +188,21 @@ def allan_variance_files(
                           progress=progress, unit="series")
 
 
+class WorkerLost(RuntimeError):
+    """A task whose worker process died (killed, e.g. out of memory) as often as the scheduler allows."""
+
+
+def _raise_task_error(future: Any, item: Any) -> None:
+    """The task's own error, or :class:`WorkerLost` in one line when its worker kept dying."""
+    from distributed import KilledWorker
+
+    try:
+        future.result()
+    except KilledWorker:
+        raise WorkerLost(f"the worker process computing {item} died repeatedly (killed by the system, e.g. out "
+                         "of memory); compute it with fewer workers, or alone") from None
+
+
 @contextmanager
 def cluster_client(scheduler: Any = None, workers: int = 2, timeout: float | None = None) -> Iterator[Any]:
     """A ``distributed.Client``: ``scheduler`` itself (a Client, left open), one connected to an address
@@ -124,7 +211,8 @@ def cluster_client(scheduler: Any = None, workers: int = 2, timeout: float | Non
     from dask.distributed import Client, LocalCluster
 
     if scheduler is None:
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                          silence_logs=logging.CRITICAL) as cluster:
             with Client(cluster) as client:
                 yield client
     elif isinstance(scheduler, str):
@@ -168,7 +256,7 @@ def map_on_cluster(
         try:
             for future in as_completed(futures):
                 if future.status == "error":
-                    future.result()  # raises the task's error
+                    _raise_task_error(future, items[futures.index(future)])
                 if bar is not None:
                     bar.update(1)
             return client.gather(futures)

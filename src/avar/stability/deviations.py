@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from avar._kernels.deviation_phase import scan
-from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, short_repr
+from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, rate_from_index, short_repr
 from avar.stability.deviation_core import OctaveMoments, deviation_levels_and_phase
 from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors
 from avar.stability.deviation_results import Deviation
@@ -50,8 +50,11 @@ _PARAMETERS = """
         1-D real data: fractional frequency y (``data_type="freq"``) or phase
         (time error) x in seconds (``data_type="phase"``). NaN marks a gap
         (see ``nan_policy``); infinite values are refused.
-    rate : float
-        Sampling rate in Hz; tau0 = 1 / rate.
+    rate : float, optional
+        Sampling rate in Hz; tau0 = 1 / rate. Default: the rate of the
+        regular time index of a pandas Series (DatetimeIndex, TimedeltaIndex,
+        PeriodIndex or float seconds), else 1 Hz; an irregular index is
+        refused (resample it, or pass ``rate``), as in :func:`avar.avar`.
     data_type : {"freq", "phase"}
         What ``data`` holds (default ``"freq"``; ``allantools`` defaults to ``"phase"``).
     taus : {"octave", "decade", "all"} or array_like of float
@@ -103,6 +106,17 @@ def _check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False)
     return values, scanned
 
 
+def _rate_of(data: Any, rate: Any) -> float:
+    """``rate``, else the rate of a pandas Series' time index, else 1 Hz."""
+    if rate is not None:
+        return check_freq(rate, "rate")
+    if isinstance(data, pd.Series):
+        index_rate = rate_from_index(data.index, "data")
+        if index_rate is not None:
+            return index_rate
+    return 1.0
+
+
 def _check_options(estimator: str, rate: Any, data_type: Any, confidence: Any, nan_policy: Any) -> float:
     if not isinstance(data_type, str) or data_type not in DATA_TYPES:
         raise ValueError(f"data_type must be 'freq' (fractional frequency) or 'phase' (time error, s), "
@@ -113,7 +127,25 @@ def _check_options(estimator: str, rate: Any, data_type: Any, confidence: Any, n
         raise TypeError(f"confidence must be a number in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
     if not 0.0 < float(confidence) < 1.0:
         raise ValueError(f"confidence must be in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
-    return check_freq(rate, "rate")
+    return rate
+
+
+#: Data beyond 2**+-SCALE_LIMIT are scaled by a power of two (exact) before any square is formed.
+SCALE_LIMIT = 400
+
+
+def _scaled(values: np.ndarray, scanned: tuple, weigh: bool) -> tuple[np.ndarray, tuple, int]:
+    """``values`` scaled by 2**-e to magnitude ~1 when near the float64 limits (squares of data near
+    1e-300 underflow to 0, of data near 1e300 overflow), with their scan and e (0: unscaled).
+
+    The deviation is then exact; the variance is its square correctly rounded (0 or subnormal for
+    data near 1e-300), and a variance beyond the float64 maximum is an error."""
+    big = max(abs(float(scanned[2])), abs(float(scanned[3])))
+    if not np.isfinite(big) or big == 0 or 2.0 ** -SCALE_LIMIT < big < 2.0 ** SCALE_LIMIT:
+        return values, scanned, 0
+    exponent = int(np.frexp(big)[1])
+    values = np.ldexp(values, -exponent)
+    return values, scan(values, weigh=weigh), exponent
 
 
 def _longest_stretch(values: np.ndarray) -> np.ndarray:
@@ -156,7 +188,7 @@ def _noise_of_levels(estimator: str, phase: np.ndarray | OctaveMoments, drift: f
 def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, confidence: Any,
               nan_policy: Any) -> Deviation:
     """Validate once, compute the variances, identify the noise and bound the deviation."""
-    rate = _check_options(estimator, rate, data_type, confidence, nan_policy)
+    rate = _check_options(estimator, _rate_of(data, rate), data_type, confidence, nan_policy)
     drift_removed = estimator in ("hdev", "ohdev") and data_type == "freq"  # the scan finds the drift too
     values, scanned = _check_data(data, data_type, nan_policy, weigh=drift_removed)
     n_missing = int(scanned[0])
@@ -165,6 +197,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     if values.size < needed:
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
     factors = deviation_factors(estimator, n_phase, rate, taus)
+    values, scanned, exponent = _scaled(values, scanned, drift_removed)
     variance, n, phase, drift = deviation_levels_and_phase(estimator, values, factors, data_type, rate, scanned)
     if n_missing:
         keep = n > 0
@@ -173,7 +206,14 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         factors, variance, n = factors[keep], variance[keep], n[keep]
     if not np.all(np.isfinite(variance)):
         raise ValueError(f"{estimator} overflows float64; rescale the data, e.g. to other units")
-    deviation = np.sqrt(variance)
+    deviation = np.ldexp(np.sqrt(variance), exponent)
+    if exponent:
+        with np.errstate(over="ignore", under="ignore"):
+            variance = np.ldexp(variance, 2 * exponent)
+        if np.isinf(variance).any():  # an underflow is the correctly rounded variance (0 or subnormal)
+            raise ValueError(f"the {estimator} variance of data of magnitude {2.0 ** exponent:.3g} is beyond the "
+                             f"float64 range (the deviation reaches {deviation.max():.3g}); rescale the data, "
+                             "e.g. to other units")
     if n_missing:
         alpha = noise_exponents(estimator, values, data_type, rate, factors)
     else:  # the variances' own detrended phase: no second pass over the data
@@ -189,7 +229,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     )
 
 
-def adev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def adev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
     """Allan deviation (non-overlapping), NIST SP 1065 eq. (7)::
 
@@ -214,7 +254,7 @@ def adev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oct
     return _estimate("adev", data, rate, data_type, taus, confidence, nan_policy)
 
 
-def oadev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def oadev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
     """Overlapping Allan deviation, NIST SP 1065 eq. (11)::
 
@@ -238,7 +278,7 @@ def oadev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     return _estimate("oadev", data, rate, data_type, taus, confidence, nan_policy)
 
 
-def mdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def mdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
     """Modified Allan deviation, NIST SP 1065 eq. (14)::
 
@@ -261,7 +301,7 @@ def mdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oct
     return _estimate("mdev", data, rate, data_type, taus, confidence, nan_policy)
 
 
-def tdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def tdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
     """Time deviation, NIST SP 1065 eq. (15): sigma_x(tau) = tau / sqrt(3) Mod sigma_y(tau), in seconds.
 
@@ -281,7 +321,7 @@ def tdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oct
     return _estimate("tdev", data, rate, data_type, taus, confidence, nan_policy)
 
 
-def hdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def hdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
     """Hadamard deviation (non-overlapping), NIST SP 1065 eq. (18)::
 
@@ -304,7 +344,7 @@ def hdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oct
     return _estimate("hdev", data, rate, data_type, taus, confidence, nan_policy)
 
 
-def ohdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def ohdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
     """Overlapping Hadamard deviation, NIST SP 1065 eq. (20)::
 
@@ -326,7 +366,7 @@ def ohdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     return _estimate("ohdev", data, rate, data_type, taus, confidence, nan_policy)
 
 
-def totdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def totdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
            confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
     """Total deviation, NIST SP 1065 eq. (25)::
 

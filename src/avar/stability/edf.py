@@ -302,8 +302,10 @@ def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE
 
     (NIST SP 1065 eq. 45). The upper quantile comes from the survival function
     so that confidences near 1 keep their precision. Both bounds are positive
-    for a positive deviation; lci <= deviation <= uci for confidence >= 0.5
-    and edf >= 1.
+    for a positive deviation. At a low confidence (below about 0.4) the
+    central chi-squared interval lies around its median, below edf, and would
+    exclude the estimate itself: the bounds are then widened to the deviation,
+    so that lci <= deviation <= uci always (a wider, conservative interval).
 
     Parameters
     ----------
@@ -326,6 +328,8 @@ def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE
     (0.19567, 0.20463)
     >>> [b.round(3).tolist() for b in chi2_bounds([1.0, 1.0], [1.0, 10.0], confidence=0.95)]
     [[0.446, 0.699], [31.91, 1.755]]
+    >>> [b.round(3).tolist() for b in chi2_bounds([1.0], [1.0], confidence=0.1)]  # lci widened to the estimate
+    [[1.0], [1.673]]
     """
     from scipy.special import chdtri, gammaincinv  # what chi2.isf / chi2.ppf call, without their overhead
 
@@ -341,7 +345,8 @@ def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE
     # uci is inf only where the lower chi-squared quantile underflows (EDF << 1 at a confidence near 1)
     with np.errstate(invalid="ignore", divide="ignore"):
         upper, lower = chdtri(edf, tail), 2.0 * gammaincinv(edf / 2.0, tail)  # chi2.isf, chi2.ppf (tail, edf)
-        return deviation * np.sqrt(edf / upper), deviation * np.sqrt(edf / lower)
+        lci, uci = deviation * np.sqrt(edf / upper), deviation * np.sqrt(edf / lower)
+        return np.minimum(lci, deviation), np.maximum(uci, deviation)
 
 
 def _real_array(values: Any, name: str) -> np.ndarray:
