@@ -141,8 +141,10 @@ def add_input_arguments(parser: argparse.ArgumentParser, many: bool = False) -> 
     parser.add_argument("--topic", metavar="TOPIC", help="sensor_msgs/Imu topic of a ROS bag (default: its only one)")
     parser.add_argument("--type", choices=["mo", "to"], default="mo", help="maximal overlap (mo) or tau overlap (to)")
     parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help="tau grid")
-    parser.add_argument("--gyro", action="append", metavar="NAME", help="gyroscope column (makes an IMU)")
-    parser.add_argument("--accel", action="append", metavar="NAME", help="accelerometer column (makes an IMU)")
+    parser.add_argument("--gyro", action="extend", nargs="+", metavar="NAME",
+                        help="gyroscope columns, e.g. --gyro gx gy gz (makes an IMU)")
+    parser.add_argument("--accel", action="extend", nargs="+", metavar="NAME",
+                        help="accelerometer columns, e.g. --accel ax ay az (makes an IMU)")
     parser.add_argument("--output", metavar="CSV", help="write the table to this CSV file ('-': stdout)")
     parser.add_argument("--plot", metavar="PNG", help="write the figure to this file (format from its extension)")
     parser.add_argument("--force", action="store_true", help="replace existing --output / --plot files")

@@ -84,11 +84,13 @@ class OutputPlan:
     figure: Path | None
     figure_format: str | None
 
-    def write(self, csv: Callable[[], str] | None = None, figure: Callable[[], object] | None = None) -> Written:
+    def write(self, csv: Callable[[], str] | None = None, figure: Callable[[], object] | None = None,
+              metadata: dict[str, str] | None = None) -> Written:
         """Render the outputs in memory, then write each to a temporary file and rename it.
 
         ``csv`` returns the CSV text and ``figure`` a matplotlib Figure; each is
-        called only if its output was requested.
+        called only if its output was requested. ``metadata`` goes into the figure
+        file (PNG text chunks, PDF/SVG metadata) as matplotlib's ``savefig`` writes it.
         """
         contents: list[tuple[Path, bytes]] = []
         stdout_csv = None
@@ -100,7 +102,7 @@ class OutputPlan:
                 contents.append((Path(self.csv), text.encode("utf-8")))
         if self.figure is not None and figure is not None:
             buffer = io.BytesIO()
-            figure().savefig(buffer, format=self.figure_format, dpi=110)
+            figure().savefig(buffer, format=self.figure_format, dpi=110, metadata=metadata)
             contents.append((self.figure, buffer.getvalue()))
         for path, data in contents:
             write_atomically(path, data)
