@@ -38,12 +38,22 @@ def read_from_args(args: argparse.Namespace):
 
 
 def _warm_up() -> None:
-    """Import the kernels and load their compiled code (numba's cache) on a tiny series."""
+    """Import the kernels and load their compiled code (numba's cache) on a tiny series.
+
+    On a cold cache the tiny series would compile the short-series kernels, which a long
+    file does not use, and hold numba's compiler lock meanwhile: then only the import
+    is done here, and the file's own call compiles what it needs.
+    """
     import numpy as np
 
+    from avar._kernels.cache_dir import cached_for_this_machine
+    from avar._kernels.small import small_allan_variance
     from avar.stability.allan import avar
 
-    avar(np.arange(8.0))
+    if cached_for_this_machine(small_allan_variance):
+        x = np.arange(8.0)
+        x.setflags(write=False)  # read-only, as a file's columns are: the same compiled signature
+        avar(x)
 
 
 def compute_from_args(args: argparse.Namespace, progress: Progress):
@@ -116,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
 
 def add_input_arguments(parser: argparse.ArgumentParser, many: bool = False) -> None:
     """The reading and output options; ``many``: one or more files (``avar compute``)."""
-    what = "CSV/TSV/text, .npy, or a ROS bag (.bag, .db3, .mcap; needs avar[ros]); see docs/reading.md"
+    what = "CSV/TSV/text, .npy, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros]); see docs/reading.md"
     if many:
         parser.add_argument("file", nargs="+",
                             help=f"{what}; several files give one table with a File column")
