@@ -17,7 +17,7 @@ import tempfile
 from collections.abc import MutableMapping
 from pathlib import Path
 
-__all__ = ["configure", "choose_cache_dir", "user_cache_dir", "writable"]
+__all__ = ["cached_for_this_machine", "choose_cache_dir", "configure", "user_cache_dir", "writable"]
 
 #: The folder of the kernels, whose ``__pycache__`` numba uses by default.
 KERNELS = Path(__file__).resolve().parent
@@ -75,3 +75,17 @@ def configure(folder: Path = KERNELS, environ: MutableMapping[str, str] = os.env
     if config is not None and environ is os.environ:
         config.CACHE_DIR = str(chosen)
     return chosen
+
+
+def cached_for_this_machine(dispatcher) -> bool:
+    """Whether numba's cache holds code of ``dispatcher`` compiled for this CPU and source.
+
+    Reads the kernel's cache index (numba returns it empty when missing or stale) and
+    looks for an entry whose code-generation key (CPU name and features) is this
+    machine's. Never compiles; False when numba's cache layout is not the expected one.
+    """
+    try:
+        magic = dispatcher.targetctx.codegen().magic_tuple()
+        return any(key[1] == magic for key in dispatcher._cache._cache_file._load_index())
+    except Exception:  # numba internals changed: assume nothing is cached
+        return False
