@@ -122,3 +122,22 @@ def test_an_unwritable_package_caches_its_kernels_in_the_user_cache(tmp_path):
     lines = subprocess.run([sys.executable, "-c", code], env=environment, capture_output=True, text=True,
                            check=True).stdout.splitlines()
     assert lines[1] == "None" and lines[2].startswith(str(copy / "avar" / "_kernels"))
+
+
+def test_the_warm_up_thread_is_quiet():
+    """compute's warm-up may compile the short-series kernel while the file is read: speculative."""
+    import threading
+
+    from avar.cli.compute import WARM_UP_THREAD
+    from avar.cli.first_run import QUIET_THREADS
+
+    assert WARM_UP_THREAD in QUIET_THREADS
+    stream = io.StringIO()
+    cube = njit(lambda x: x * x * x)
+    with compile_notice("compute", stream) as notice:
+        worker = threading.Thread(target=cube, args=(2.0,), name=WARM_UP_THREAD)
+        worker.start()
+        worker.join()
+        assert notice.compiled == 0 and stream.getvalue() == ""
+        assert cube(2) == 8  # a new signature, in the run's own thread
+    assert notice.compiled == 1 and stream.getvalue().count(NOTICE) == 1

@@ -37,6 +37,10 @@ def read_from_args(args: argparse.Namespace):
     return data
 
 
+#: The warm-up's thread: its compilations are speculative, the first-run notice ignores them.
+WARM_UP_THREAD = "avar-warm-up"
+
+
 def _warm_up() -> None:
     """Import the kernels and load their compiled code (numba's cache) on a tiny series.
 
@@ -62,7 +66,7 @@ def compute_from_args(args: argparse.Namespace, progress: Progress):
     The kernels load in a background thread while the file is parsed (pandas' C parser
     releases the GIL), so their start-up time overlaps the reading.
     """
-    warm_up = threading.Thread(target=_warm_up, name="avar-warm-up", daemon=True)
+    warm_up = threading.Thread(target=_warm_up, name=WARM_UP_THREAD, daemon=True)
     warm_up.start()
     progress(f"reading {args.file}")
     try:

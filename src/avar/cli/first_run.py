@@ -16,7 +16,13 @@ import sys
 import threading
 from contextlib import contextmanager
 
-__all__ = ["COMPILE_SECONDS", "CompileNotice", "compile_notice", "notice_text"]
+__all__ = ["COMPILE_SECONDS", "NOTICE_START", "QUIET_THREADS", "CompileNotice", "compile_notice", "notice_text"]
+
+#: How the notice begins (a stable prefix for whoever filters stderr).
+NOTICE_START = "avar: compiling the numerical kernels"
+#: Threads whose compilations are speculative (``avar compute``'s warm-up while the file
+#: is read) and do not make the run say it compiles.
+QUIET_THREADS = frozenset({"avar-warm-up"})
 
 #: Rough compile time of each subcommand's kernels on an idle 2-core machine, seconds
 #: (cold minus warm run of benchmarks/bench_cli_startup.py).
@@ -32,7 +38,7 @@ def notice_text(command: str) -> str:
     seconds = COMPILE_SECONDS.get(command, 10)
     where = os.environ.get("NUMBA_CACHE_DIR")
     later = f"later runs load them from {where}" if where else "later runs load them from numba's cache"
-    return f"avar: compiling the numerical kernels for this machine (first run only; about {seconds} s); {later}"
+    return f"{NOTICE_START} for this machine (first run only; about {seconds} s); {later}"
 
 
 class CompileNotice:
@@ -45,6 +51,8 @@ class CompileNotice:
         self._lock = threading.Lock()
 
     def on_start(self, event) -> None:
+        if threading.current_thread().name in QUIET_THREADS:
+            return
         with self._lock:
             self.compiled += 1
             if self.compiled > 1:
