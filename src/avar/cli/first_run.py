@@ -24,21 +24,22 @@ NOTICE_START = "avar: compiling the numerical kernels"
 #: is read) and do not make the run say it compiles.
 QUIET_THREADS = frozenset({"avar-warm-up"})
 
-#: Rough compile time of each subcommand's kernels on an idle 2-core machine, seconds
-#: (cold minus warm run of benchmarks/bench_cli_startup.py).
-COMPILE_SECONDS = {"demo": 10, "compute": 5, "fit": 10, "report": 15}
+#: Rough compile time of each subcommand's kernels on one idle core, seconds: the CPU time
+#: of a cold run less a warm one in benchmarks/bench_cli_startup.py (demo 7.5 s, report of
+#: a 2 h 200 Hz 6-axis log 27 s); compute and fit of a long file compile the same kernels.
+COMPILE_SECONDS = {"demo": 10, "compute": 30, "fit": 30, "report": 30}
 
 
 def notice_text(command: str) -> str:
     """The one line printed when the first kernel of ``command`` compiles.
 
     >>> print(notice_text("report"))  # doctest: +ELLIPSIS
-    avar: compiling the numerical kernels for this machine (first run only; about 15 s); later runs load them ...
+    avar: compiling the numerical kernels for this machine (first run only; up to about 30 s); later runs load them ...
     """
     seconds = COMPILE_SECONDS.get(command, 10)
     where = os.environ.get("NUMBA_CACHE_DIR")
     later = f"later runs load them from {where}" if where else "later runs load them from numba's cache"
-    return f"{NOTICE_START} for this machine (first run only; about {seconds} s); {later}"
+    return f"{NOTICE_START} for this machine (first run only; up to about {seconds} s); {later}"
 
 
 class CompileNotice:
