@@ -165,7 +165,7 @@ def test_without_dask_distributed_the_message_says_what_to_install(capsys, files
                         lambda name, *rest: None if name == "distributed" else find_spec(name, *rest))
     code, _, err = cli(capsys, "compute", files[0], "--workers", "2")
     assert code == 2
-    assert 'dask.distributed, which is not installed: pip install "avar[dask]"' in err
+    assert 'dask.distributed, which is not installed: pip install "allanvar[dask]"' in err
 
 
 @pytest.mark.parametrize("on_cluster", [False, True])

@@ -19,9 +19,16 @@ tests check every kernel against a plain NumPy transcription.
   covariance matrix (one validating pass, then O(n) per scale).
 * :mod:`avar._kernels.robust`: residuals from interpolation and the running median (outliers).
 * :mod:`avar._kernels.simulation`: recursions of the simulated processes.
+* :mod:`avar._kernels.cache_dir`: where numba's cache goes (the user's cache
+  directory when the package folder is not writable).
 """
 
 import os
+
+from avar._kernels.cache_dir import configure as _configure_cache
+
+# Before numba loads: a read-only package keeps its compiled kernels in the user's cache.
+_configure_cache()
 
 # numba's OpenMP threads spin-wait between parallel regions by default; when
 # another process holds a core, a short parallel call can then take 10-100x

@@ -345,5 +345,6 @@ def far_sums(rows, scale, centre, th, tl, spread, factors, nd, fine, tol=CERTIFY
     result = np.zeros((channels, factors.shape[0]))
     for c in range(channels):
         for a in range(classes):
-            result[c] += out[c, a]
+            for k in range(factors.shape[0]):  # element by element: a row assignment would compile
+                result[c, k] += out[c, a, k]  # numba's shape-mismatch message (strings), seconds cold
     return result

@@ -74,5 +74,6 @@ def sweep_sums(data, centre, scale, factors, nd, block, chunk):
     result = np.zeros((channels, factors.shape[0]))
     for c in range(channels):
         for j in range(n_chunks):
-            result[c] += out[c, j]
+            for k in range(factors.shape[0]):  # element by element: a row assignment would compile
+                result[c, k] += out[c, j, k]  # numba's shape-mismatch message (strings), seconds cold
     return result

@@ -37,13 +37,27 @@ def read_from_args(args: argparse.Namespace):
     return data
 
 
+#: The warm-up's thread: its compilations are speculative, the first-run notice ignores them.
+WARM_UP_THREAD = "avar-warm-up"
+
+
 def _warm_up() -> None:
-    """Import the kernels and load their compiled code (numba's cache) on a tiny series."""
+    """Import the kernels and load their compiled code (numba's cache) on a tiny series.
+
+    On a cold cache the tiny series would compile the short-series kernels, which a long
+    file does not use, and hold numba's compiler lock meanwhile: then only the import
+    is done here, and the file's own call compiles what it needs.
+    """
     import numpy as np
 
+    from avar._kernels.cache_dir import cached_for_this_machine
+    from avar._kernels.small import small_allan_variance
     from avar.stability.allan import avar
 
-    avar(np.arange(8.0))
+    if cached_for_this_machine(small_allan_variance):
+        x = np.arange(8.0)
+        x.setflags(write=False)  # read-only, as a file's columns are: the same compiled signature
+        avar(x)
 
 
 def compute_from_args(args: argparse.Namespace, progress: Progress):
@@ -52,7 +66,7 @@ def compute_from_args(args: argparse.Namespace, progress: Progress):
     The kernels load in a background thread while the file is parsed (pandas' C parser
     releases the GIL), so their start-up time overlaps the reading.
     """
-    warm_up = threading.Thread(target=_warm_up, name="avar-warm-up", daemon=True)
+    warm_up = threading.Thread(target=_warm_up, name=WARM_UP_THREAD, daemon=True)
     warm_up.start()
     progress(f"reading {args.file}")
     try:
@@ -116,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
 
 def add_input_arguments(parser: argparse.ArgumentParser, many: bool = False) -> None:
     """The reading and output options; ``many``: one or more files (``avar compute``)."""
-    what = "CSV/TSV/text, .npy, or a ROS bag (.bag, .db3, .mcap; needs avar[ros]); see docs/reading.md"
+    what = "CSV/TSV/text, .npy, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros]); see docs/reading.md"
     if many:
         parser.add_argument("file", nargs="+",
                             help=f"{what}; several files give one table with a File column")
@@ -141,8 +155,10 @@ def add_input_arguments(parser: argparse.ArgumentParser, many: bool = False) -> 
     parser.add_argument("--topic", metavar="TOPIC", help="sensor_msgs/Imu topic of a ROS bag (default: its only one)")
     parser.add_argument("--type", choices=["mo", "to"], default="mo", help="maximal overlap (mo) or tau overlap (to)")
     parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help="tau grid")
-    parser.add_argument("--gyro", action="append", metavar="NAME", help="gyroscope column (makes an IMU)")
-    parser.add_argument("--accel", action="append", metavar="NAME", help="accelerometer column (makes an IMU)")
+    parser.add_argument("--gyro", action="extend", nargs="+", metavar="NAME",
+                        help="gyroscope columns, e.g. --gyro gx gy gz (makes an IMU)")
+    parser.add_argument("--accel", action="extend", nargs="+", metavar="NAME",
+                        help="accelerometer columns, e.g. --accel ax ay az (makes an IMU)")
     parser.add_argument("--output", metavar="CSV", help="write the table to this CSV file ('-': stdout)")
     parser.add_argument("--plot", metavar="PNG", help="write the figure to this file (format from its extension)")
     parser.add_argument("--force", action="store_true", help="replace existing --output / --plot files")

@@ -40,7 +40,7 @@ CONNECT_TIMEOUT = 15.0
 ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+]*://)?(?:\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):\d{1,5}$")
 #: Silences the resource tracker's "leaked semaphore" warning after an interrupted cluster run.
 QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
-DASK_MISSING = '--workers/--scheduler run on dask.distributed, which is not installed: pip install "avar[dask]"'
+DASK_MISSING = '--workers/--scheduler run on dask.distributed, which is not installed: pip install "allanvar[dask]"'
 
 
 def positive_int(text: str) -> int:
@@ -65,10 +65,10 @@ def scheduler_address(text: str) -> str:
 def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workers", type=positive_int, metavar="N", default=None,
                         help="compute the files in parallel on a local dask cluster of N worker processes "
-                             "(needs avar[dask])")
+                             "(needs allanvar[dask])")
     parser.add_argument("--scheduler", type=scheduler_address, metavar="ADDRESS", default=None,
                         help="compute the files on the dask.distributed scheduler at ADDRESS, "
-                             "e.g. tcp://10.0.0.5:8786 (needs avar[dask])")
+                             "e.g. tcp://10.0.0.5:8786 (needs allanvar[dask])")
 
 
 # ----------------------------------------------------------------------------- one file, anywhere

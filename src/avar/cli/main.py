@@ -13,10 +13,12 @@ import os
 import re
 import sys
 import threading
+import warnings
 
 from avar._validation import cap_text, check_freq
 from avar.cli import compute, datasets, demo, deviation, fit, report
 from avar.cli.common import InputFileError, UsageError, printable
+from avar.cli.first_run import COMPILE_SECONDS, compile_notice
 from avar.cli.outputs import remove_pending
 
 SUBCOMMANDS = (demo, compute, deviation, fit, report, datasets)
@@ -34,7 +36,10 @@ class Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from avar import __version__
+
     parser = Parser(prog="avar", description="Allan variance and AVLR noise model estimation")
+    parser.add_argument("--version", action="version", version=f"avar {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     for subcommand in SUBCOMMANDS:
         subcommand.add_parser(commands)
@@ -144,7 +149,19 @@ def _standard_streams() -> None:
         setattr(sys, name, open(fd, "w", closefd=False))
 
 
+def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning of any library as one line of ours on stderr: no source line, no file path."""
+    text = str(message).strip().splitlines()
+    print(f"avar: warning: {cap_text(text[0] if text else category.__name__)}", file=sys.stderr, flush=True)
+
+
 def main(argv: list[str] | None = None) -> int:
+    with warnings.catch_warnings():
+        warnings.showwarning = show_warning
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     _standard_streams()
     argv = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
     parser = build_parser()
@@ -162,7 +179,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"avar {args.command}: error: {error}", file=sys.stderr)
             return 2
     try:
-        code, _ = _run_interruptibly(args.handler, args)
+        if args.command in COMPILE_SECONDS:  # the subcommands that run kernels: say so if they compile
+            with compile_notice(args.command):
+                code, _ = _run_interruptibly(args.handler, args)
+        else:
+            code, _ = _run_interruptibly(args.handler, args)
         return code
     except KeyboardInterrupt:
         return _interrupted()

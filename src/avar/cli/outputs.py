@@ -152,13 +152,15 @@ class OutputPlan:
     force: bool = False
 
     def write(self, csv: Callable[[], str] | None = None, figure: Callable[[], object] | None = None,
-              extra: Sequence[tuple[Path, Callable[[], bytes]]] = ()) -> Written:
+              extra: Sequence[tuple[Path, Callable[[], bytes]]] = (),
+              metadata: dict[str, str] | None = None) -> Written:
         """Render every output in memory, then write each to a temporary file and rename it.
 
         ``csv`` returns the CSV text and ``figure`` a matplotlib Figure; each is
         called only if its output was requested. ``extra``: (path, bytes) of
-        further files (a Kalibr yaml). Nothing is written unless every output
-        rendered.
+        further files (a Kalibr yaml). ``metadata`` goes into the figure file
+        (PNG text chunks, PDF/SVG metadata) as matplotlib's ``savefig`` writes
+        it. Nothing is written unless every output rendered.
         """
         contents: list[tuple[Path, bytes]] = []
         stdout_csv = None
@@ -172,7 +174,7 @@ class OutputPlan:
                 contents.append((Path(self.csv), text.encode("utf-8")))
         if self.figure is not None and figure is not None:
             buffer = io.BytesIO()
-            figure().savefig(buffer, format=self.figure_format, dpi=110)
+            figure().savefig(buffer, format=self.figure_format, dpi=110, metadata=metadata)
             contents.append((self.figure, buffer.getvalue()))
         write_all(contents, self.force)
         return Written(tuple(str(path) for path, _ in contents), stdout_csv)

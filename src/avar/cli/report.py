@@ -35,11 +35,16 @@ def read_recording(args: argparse.Namespace):
                 topic=args.topic if is_bag else None)
     if isinstance(data, IMU):
         values = {name: data[name] for name in data.channels}
-        return SimpleNamespace(columns=values, freq=data.freq, source=str(args.file), topic=data.name, bag=True)
+        return SimpleNamespace(columns=values, freq=data.freq, source=str(args.file), topic=data.name,
+                               notes=[f"{args.file}: {data.describe()}"], bag=True)
     if data.time_column is None and args.freq is None:
         raise InputFileError(f"{args.file}: no time column to take the rate from; pass --freq (Hz)")
+    # The rate, where it comes from and the timestamps' jitter, as `avar compute` says them.
+    notes = [data.describe().replace("(given)", "(--freq)")]
+    if data.gaps_ignored:
+        notes.append(f"{args.file}: --gaps ignore: the samples are treated as contiguous across the gaps")
     return SimpleNamespace(columns=dict(data.columns), freq=data.freq, source=str(args.file), topic=args.topic,
-                           bag=is_bag)
+                           notes=notes, bag=is_bag)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -67,8 +72,8 @@ def run(args: argparse.Namespace) -> int:
     progress = Progress()
     progress(f"reading {args.file}")
     recording = read_recording(args)
-    n = len(next(iter(recording.columns.values())))
-    print(f"{args.file}: {len(recording.columns)} column(s) x {n} samples at {recording.freq:g} Hz", file=sys.stderr)
+    for note in recording.notes:
+        print(note, file=sys.stderr)
     progress("fitting the noise terms")
     report = noise_report(recording, gyro_units=args.gyro_units, accel_units=args.accel_units,
                           gyro=args.gyro, accel=args.accel, alpha=args.alpha, name=Path(args.file).name,
@@ -101,11 +106,13 @@ def add_parser(commands) -> None:
     report = commands.add_parser(
         "report", help="IMU noise report: ARW, bias instability, RRW (IEEE 952), Kalibr imu.yaml, figure"
     )
-    report.add_argument("file", help="CSV/TSV/text, .npy, or a ROS bag (.bag, .db3, .mcap; needs avar[ros])")
+    report.add_argument("file", help="CSV/TSV/text, .npy, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros])")
     report.add_argument("--topic", help="sensor_msgs/Imu topic of a ROS bag (default: its only one); "
                         "written as Kalibr's rostopic")
-    report.add_argument("--gyro", nargs="+", metavar="NAME", help="gyroscope columns (default: by name)")
-    report.add_argument("--accel", nargs="+", metavar="NAME", help="accelerometer columns (default: by name)")
+    report.add_argument("--gyro", action="extend", nargs="+", metavar="NAME",
+                        help="gyroscope columns, e.g. --gyro gx gy gz (default: by name)")
+    report.add_argument("--accel", action="extend", nargs="+", metavar="NAME",
+                        help="accelerometer columns, e.g. --accel ax ay az (default: by name)")
     report.add_argument("--gyro-units", choices=["rad/s", "deg/s", "deg/h"], help="gyroscope data unit (default rad/s)")
     report.add_argument("--accel-units", choices=["m/s^2", "g", "mg"], help="accelerometer data unit (default m/s^2)")
     report.add_argument("--freq", type=float, help="sampling rate in Hz (default: from a time column)")

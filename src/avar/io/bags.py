@@ -1,6 +1,6 @@
 """ROS bags: ``sensor_msgs/msg/Imu`` topics of ROS 1 ``.bag`` and ROS 2 ``.db3``/``.mcap`` bags.
 
-Read with the ``rosbags`` package (``pip install "avar[ros]"``), which needs no ROS
+Read with the ``rosbags`` package (``pip install "allanvar[ros]"``), which needs no ROS
 installation. A ROS 2 bag is given as its ``.db3``/``.mcap`` file or as its directory
 (with ``metadata.yaml``). Each message gives one sample of six channels:
 
@@ -48,7 +48,7 @@ def _reader(path: Path):
         from rosbags.typesys import Stores, get_typestore
     except ImportError:
         raise ImportError(
-            f"{path}: reading ROS bags needs the 'rosbags' package: pip install \"avar[ros]\""
+            f"{path}: reading ROS bags needs the 'rosbags' package: pip install \"allanvar[ros]\""
         ) from None
     return AnyReader([path], default_typestore=get_typestore(Stores.LATEST))
 

@@ -129,7 +129,7 @@ def read(
         CSV / TSV / semicolon-separated (decimal commas) / whitespace-separated text,
         with or without a header row (a ``# time gx gy`` comment line is a header);
         ``.npy`` (plain or structured); a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
-        bag (see :func:`avar.io.bags.read_bag`; needs ``avar[ros]``).
+        bag (see :func:`avar.io.bags.read_bag`; needs ``allanvar[ros]``).
     columns : str or list of str, optional
         Data columns to keep (default: all but the time columns). A time column is
         never data.

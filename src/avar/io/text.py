@@ -269,33 +269,11 @@ def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[d
     extra = "\0trailing separator"
     columns = _Columns(count_lines(path) + 1 - layout.skip)
     try:
-        with pd.read_csv(
-            stream if stream is not None else path,
-            sep=layout.separator,
-            decimal=layout.decimal,
-            header=None,
-            names=[*names, extra] if layout.trailing else names,
-            skiprows=layout.skip + (1 if layout.header_row else 0),
-            index_col=False,
-            engine="c",
-            encoding=layout.encoding,
-            skip_blank_lines=False,  # a blank line inside the data is a missing sample, not nothing
-            quotechar='"',
-            chunksize=CHUNK_ROWS,
-        ) as chunks, warnings.catch_warnings():
-            warnings.simplefilter("error", pd.errors.ParserWarning)  # pandas would drop the extra fields
-            for chunk in chunks:
-                if layout.trailing:
-                    spill = chunk[extra].notna().to_numpy()
-                    if spill.any():
-                        row = columns.n + int(np.flatnonzero(spill)[0])
-                        raise ValueError(
-                            f"{path}: line {row + layout.first_data_line} has a value after the last column "
-                            f"({clip(str(chunk[extra].to_numpy()[spill][0]))}); every line must have the "
-                            f"header's {len(names)} columns"
-                        )
-                    chunk = chunk.drop(columns=extra)
-                columns.add(chunk)
+        with warnings.catch_warnings():
+            # A column whose blocks parse to different types is object here; numeric_column then
+            # parses it or names its first non-number, so pandas' DtypeWarning would only be noise.
+            warnings.simplefilter("ignore", pd.errors.DtypeWarning)
+            _read_chunks(stream if stream is not None else path, layout, names, extra, columns, path)
     except pd.errors.EmptyDataError:
         raise ValueError(f"{path}: the file holds a header but no data") from None
     except pd.errors.ParserWarning:
@@ -307,6 +285,37 @@ def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[d
     if not columns.arrays:
         raise ValueError(f"{path}: the file holds a header but no data")
     return columns.finish(), layout
+
+
+def _read_chunks(source, layout: Layout, names: list[str], extra: str, columns: _Columns, path: Path) -> None:
+    """Parse the table with pandas' C engine, chunk by chunk, into ``columns``."""
+    with pd.read_csv(
+        source,
+        sep=layout.separator,
+        decimal=layout.decimal,
+        header=None,
+        names=[*names, extra] if layout.trailing else names,
+        skiprows=layout.skip + (1 if layout.header_row else 0),
+        index_col=False,
+        engine="c",
+        encoding=layout.encoding,
+        skip_blank_lines=False,  # a blank line inside the data is a missing sample, not nothing
+        quotechar='"',
+        chunksize=CHUNK_ROWS,
+    ) as chunks, warnings.catch_warnings():
+        warnings.simplefilter("error", pd.errors.ParserWarning)  # pandas would drop the extra fields
+        for chunk in chunks:
+            if layout.trailing:
+                spill = chunk[extra].notna().to_numpy()
+                if spill.any():
+                    row = columns.n + int(np.flatnonzero(spill)[0])
+                    raise ValueError(
+                        f"{path}: line {row + layout.first_data_line} has a value after the last column "
+                        f"({clip(str(chunk[extra].to_numpy()[spill][0]))}); every line must have the "
+                        f"header's {len(names)} columns"
+                    )
+                chunk = chunk.drop(columns=extra)
+            columns.add(chunk)
 
 
 def numeric_column(column: np.ndarray, name: str, layout: Layout, path: Path) -> np.ndarray:
