@@ -152,4 +152,5 @@ def test_warnings_and_curves_are_rendered_when_the_report_has_them():
     assert parsed.tables["curves"] == [["Channel", "Tau (s)", "Deviation"], ["x", "0.01", "0.0015"], ["x", "0.02", ""]]
     plain = Page()
     plain.feed(report_html(report, figures=[]))
-    assert "curves" not in plain.tables and "none" in "".join(plain.text)
+    assert plain.tables["curves"][0][:6] == ["Channel", "Tau (s)", "ADEV", "Lower", "Upper", "Implied ADEV"]
+    assert len(plain.tables["curves"]) == len(report.curves) + 1 and "none" in "".join(plain.text)
