@@ -22,8 +22,7 @@ from avar.plotting.base import (
     new_axes,
     setup_log_axes,
 )
-from avar.stability.deviation_grids import LONG_NAMES
-from avar.stability.deviation_results import Deviation
+from avar.stability.deviation_results import LONG_NAMES, Deviation
 
 
 def plot_deviation(
@@ -98,7 +97,7 @@ def plot_deviation(
                         label=f"{x.confidence:.3g} confidence (chi-squared)")
             drawn += [x.lci[valid], x.uci[valid]]
     if ylab is None:
-        ylab = f"{x.name} $\\sigma_x(\\tau)$ (s)" if x.estimator == "tdev" else f"{x.name} $\\sigma_y(\\tau)$"
+        ylab = f"{x.name} $\\sigma_x(\\tau)$ (s)" if x.estimator in ("tdev", "ttotdev") else f"{x.name} $\\sigma_y(\\tau)$"
     xlab = r"Averaging time $\tau$ (s)" if xlab is None else xlab
     title = f"{LONG_NAMES[x.estimator].capitalize()} ({x.data_type} data)" if main is None else main
     finish(ax, xlab, ylab, title, legend, log_limits(*drawn))

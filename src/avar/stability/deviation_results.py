@@ -13,7 +13,13 @@ import pandas as pd
 
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
-from avar.stability.deviation_grids import ESTIMATORS, LONG_NAMES
+from avar.stability.deviation_grids import ESTIMATORS as _FAMILY
+from avar.stability.deviation_grids import LONG_NAMES as _FAMILY_NAMES
+from avar.stability.total_edf import TOTAL_ESTIMATORS, TOTAL_LONG_NAMES
+
+#: Every estimator a Deviation may hold: the family and the total and Theo statistics.
+ESTIMATORS = (*_FAMILY, *TOTAL_ESTIMATORS)
+LONG_NAMES = {**_FAMILY_NAMES, **TOTAL_LONG_NAMES}
 
 #: Columns of :meth:`Deviation.summary`, in the order of Stable32's run table.
 SUMMARY_COLUMNS = ["Tau", "m", "N terms", "Alpha", "Min sigma", "Sigma", "Max sigma", "EDF"]
