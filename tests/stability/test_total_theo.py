@@ -99,14 +99,14 @@ def test_theo1_equals_exact_formula(m):
 
 
 def test_kernels_match_the_plain_loops_on_larger_data():
-    x = np.cumsum(RNG.standard_normal(90))
-    for m in (1, 4, 29):
+    x = np.cumsum(RNG.standard_normal(60))
+    for m in (1, 4, 19):
         total, count = mtot_sum(x, m, NO_GAPS, 0)
-        assert count == 90 - 3 * m + 1
+        assert count == 60 - 3 * m + 1
         assert total / (2 * m * m * count) == pytest.approx(float(plain_mtotvar(exact(x), m)), rel=1e-10)
     y = np.diff(x)
-    total, count = htot_sum(x, 7, NO_GAPS, 0)
-    assert total / (6 * count) == pytest.approx(float(plain_htotvar(exact(y), 7)), rel=1e-10)
+    total, count = htot_sum(x, 6, NO_GAPS, 0)
+    assert total / (6 * count) == pytest.approx(float(plain_htotvar(exact(y), 6)), rel=1e-10)
 
 
 def test_theo1_all_factors_at_once_equals_the_direct_sum():
@@ -120,7 +120,7 @@ def test_theo1_all_factors_at_once_equals_the_direct_sum():
 @pytest.mark.parametrize("name", ["mtotdev", "ttotdev", "htotdev", "theo1"])
 @pytest.mark.parametrize("data_type", ["phase", "freq"])
 def test_equal_to_allantools(name, data_type):
-    data = np.cumsum(RNG.standard_normal(300)) if data_type == "phase" else RNG.standard_normal(300)
+    data = np.cumsum(RNG.standard_normal(160)) if data_type == "phase" else RNG.standard_normal(160)
     ours = getattr(avar, name)(data, rate=10.0, data_type=data_type, taus="octave", bias_correction=False)
     taus = ours.averaging_factors / 10.0
     theirs = getattr(allantools, name)(data, rate=10.0, data_type=data_type, taus=taus)

@@ -31,7 +31,9 @@ class Deviation:
 
     Build it with :func:`avar.adev`, :func:`avar.oadev`, :func:`avar.mdev`,
     :func:`avar.tdev`, :func:`avar.hdev`, :func:`avar.ohdev` or
-    :func:`avar.totdev`; the fields are read-only.
+    :func:`avar.totdev`, or the total and Theo statistics :func:`avar.mtotdev`,
+    :func:`avar.ttotdev`, :func:`avar.htotdev`, :func:`avar.theo1` and
+    :func:`avar.theoh`; the fields are read-only.
 
     Attributes
     ----------
@@ -53,7 +55,8 @@ class Deviation:
     lci, uci : ndarray
         Lower and upper chi-squared confidence bounds of the deviation.
     estimator : str
-        ``"adev"``, ``"oadev"``, ``"mdev"``, ``"tdev"``, ``"hdev"``, ``"ohdev"`` or ``"totdev"``.
+        ``"adev"``, ``"oadev"``, ``"mdev"``, ``"tdev"``, ``"hdev"``, ``"ohdev"``, ``"totdev"``,
+        ``"mtotdev"``, ``"ttotdev"``, ``"htotdev"``, ``"theo1"`` or ``"theoh"``.
     data_type : {"phase", "freq"}
         What the input held: phase (time error, s) or fractional frequency.
     rate : float
