@@ -94,7 +94,7 @@ def test_htotdev_is_ohdev_at_one_and_blind_to_drift():
 @pytest.mark.parametrize("m", [2, 4, 10, 38])
 def test_theo1_equals_exact_formula(m):
     res = avar.theo1(SMALL_X, rate=2.0, data_type="phase", taus=[0.75 * m / 2.0])
-    assert res.taus.tolist() == [0.375 * m] and res.n.tolist() == [40 - m]
+    assert res.taus.tolist() == [0.375 * m] and res.n.tolist() == [(40 - m) * m // 2]
     assert res.variance[0] == pytest.approx(float(plain_theo1(exact(SMALL_X), m)) * 4.0, rel=1e-11)
 
 
@@ -130,8 +130,7 @@ def test_equal_to_allantools(name, data_type):
     np.testing.assert_allclose(ours.deviation[first:k], theirs[1][first:k], rtol=1e-10)
     if name == "theo1":
         np.testing.assert_allclose(theirs[0] * 0.75, ours.taus[:k])  # allantools labels Theo1 at m tau0
-    else:
-        assert ours.n[:k].tolist() == theirs[3].astype(int).tolist()
+    assert ours.n[:k].tolist() == theirs[3].astype(int).tolist()
 
 
 def test_large_offset_and_frequency_do_not_cost_accuracy():
@@ -182,7 +181,7 @@ def test_edf_and_bias_formulas():
         ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * r**1.5 / (r**1.5 + 5.2))
     assert total_edf("htotdev", np.array([-1]), np.array([32]), 1001)[0] == pytest.approx((n / 32) / (0.868 + 1.14 * 32 / n))
     assert total_edf("htotdev", np.array([-1]), np.array([8]), 1001)[0] == pytest.approx(
-        estimator_edf("hdev", [-1], [8], 1001)[0])
+        estimator_edf("ohdev", [-1], [8], 1001)[0])
     y = np.random.default_rng(5).standard_normal(500)
     raw = avar.htotdev(y, taus=[4.0], alpha=-1, bias_correction=False)
     fixed = avar.htotdev(y, taus=[4.0], alpha=-1)
@@ -203,7 +202,7 @@ def test_gaps_skip_the_windows_that_touch_them():
     expected = sum(reflected_total(exact(x[i : i + 6]), 2) for i in windows) / (2 * 4 * len(windows))
     assert res.n.tolist() == [len(windows)] and res.variance[0] == pytest.approx(float(expected), rel=1e-10)
     th = avar.theo1(holed, data_type="phase", taus=[3.0], nan_policy="omit")
-    assert th.n.tolist() == [len([i for i in range(56) if not 26 <= i <= 30])]
+    assert th.n.tolist() == [2 * len([i for i in range(56) if not 26 <= i <= 30])]
     with pytest.raises(ValueError, match="NaN"):
         avar.theoh(np.concatenate((x, holed)), data_type="phase", nan_policy="omit")
 
@@ -229,3 +228,25 @@ def test_grids_and_validation():
     res = avar.ttotdev(SMALL_Y, rate=2.0, alpha=-1)
     assert res.estimator == "ttotdev" and set(res.alpha.tolist()) == {-1}
     assert "time total deviation" in str(res) and len(res.summary()) == len(res)
+
+
+# Stable32 on its PHASE.DAT (N = 1001 phase points), confidence 0.683: AF, #, alpha, min, sigma, max.
+STABLE32_HTOTDEV = [(16, 953, 0, 6.1280e-02, 6.5265e-02, 7.0151e-02), (32, 905, 0, 4.0870e-02, 4.4644e-02, 4.9703e-02),
+                    (64, 809, 0, 2.9694e-02, 3.3576e-02, 3.9530e-02)]
+STABLE32_COUNTS = {"mtotdev": {1: 999, 2: 996, 16: 954, 256: 234}, "htotdev": {1: 998, 2: 995, 128: 617, 256: 233},
+                   "theo1": {10: 4955, 100: 45050, 998: 1497}}  # Thêo1 #, printed 4.9550e+03 ...
+
+
+def test_stable32_htotdev_bounds_and_term_counts():
+    from avar.stability.edf import chi2_bounds
+    from avar.stability.total_edf import term_counts
+
+    rows = np.array(STABLE32_HTOTDEV)
+    edf = total_edf("htotdev", rows[:, 2].astype(int), rows[:, 0].astype(int), 1001)
+    lci, uci = chi2_bounds(rows[:, 4], edf, 0.683)
+    np.testing.assert_allclose(lci, rows[:, 3], rtol=1e-3)  # Stable32 prints 5 digits
+    np.testing.assert_allclose(uci, rows[:, 5], rtol=1e-3)
+    for name, counts in STABLE32_COUNTS.items():
+        assert term_counts(name, 1001, np.array(list(counts))).tolist() == list(counts.values())
+    # Stable32's HTOTDEV of PHASE.DAT with and without its bias removal at m = 2 (alpha = 0):
+    assert (2.0297e-01 / 2.0247e-01) ** 2 == pytest.approx(1 / 0.995, rel=5e-4)

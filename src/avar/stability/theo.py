@@ -78,7 +78,7 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     :func:`avar.theo1`, tau = 0.75 m tau0) from k. Each level's noise is
     identified by the OADEV rules (at 0.75 m for Theo1 levels) or fixed by
     ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. ``n``: N - 2m
-    (OADEV), N - m (Theo1). Dimensionless.
+    (OADEV), (N - m) m / 2 (Theo1, as Stable32). Dimensionless.
 
     Parameters
     ----------
@@ -109,8 +109,8 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     >>> res = avar.theoh(y)
     >>> res.taus.tolist()
     [1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 192.0, 384.0]
-    >>> res.n.tolist()[6:]  # N - 2m (OADEV), then N - m (Theo1)
-    [873, 745, 489]
+    >>> res.n.tolist()[6:]  # N - 2m (OADEV), then (N - m) m / 2 (Theo1)
+    [873, 95360, 125184]
     """
     alpha = check_alpha(alpha)
     if isinstance(switch, (bool, np.bool_)) or not isinstance(switch, numbers.Real) or not 0.0 < switch <= 0.5:
@@ -144,6 +144,6 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     deviation = np.sqrt(variance)
     lci, uci = chi2_bounds(deviation, edf, float(confidence))
     return Deviation(taus=np.concatenate((allan, 0.75 * theo)) / rate, averaging_factors=factors, deviation=deviation,
-                     variance=variance, n=np.concatenate((n_phase - 2 * allan, counts)), alpha=alphas, edf=edf,
+                     variance=variance, n=np.concatenate((n_phase - 2 * allan, counts * (theo // 2))), alpha=alphas, edf=edf,
                      lci=lci, uci=uci, estimator="theoh", data_type=data_type, rate=rate, n_samples=values.size,
                      confidence=float(confidence))

@@ -108,6 +108,7 @@ def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.nd
                 variance[0], counts[0] = _ohvar1(x, bad, shift)
         elif estimator == "theo1":
             variance = sums / (0.75 * counts * m * m)
+            counts = counts * (factors // 2)  # Stable32's count: the inner terms
         else:
             variance = sums / (2.0 * m * m * counts)
         variance = variance / scale / scale * (rate * rate if is_phase else 1.0)
@@ -242,7 +243,8 @@ def htotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     ``bias_correction=True`` (default, Stable32) divides by E[Htot var] / Hvar
     = 1 + a for m > 1, a = -0.005, -0.149, -0.229 for alpha = 0, -1, -2 (none
     for PM noise); ``allantools`` applies none. EDF: the Hadamard variance's
-    below m = 16, then (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`).
+    below m = 16, then (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`),
+    which equals Stable32's printed bounds from m = 16.
     {parameters}
     References
     ----------
@@ -269,7 +271,7 @@ def theo1(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
         Theo1(m) = 1 / (0.75 (N - m) (m tau0)^2) sum_{i=0}^{N-m-1} sum_{d=0}^{m/2-1}
                    [(x_i - x_{i-d+m/2}) + (x_{i+m} - x_{i+d+m/2})]^2 / (m/2 - d),
 
-    m = 2, 4, ... <= N - 1, n = N - m outer terms. Dimensionless. Unbiased
+    m = 2, 4, ... <= N - 1, n = (N - m) m / 2 terms (Stable32's ``Thêo1 #``). Dimensionless. Unbiased
     against the Allan variance for white FM only: ``bias_correction=True``
     multiplies by AVAR / Theo1 = a + b / r^c, r = 0.75 m (Howe and Tasset 2004;
     white PM 0.09, 0.74, 0.40; flicker PM 0.14, 0.82, 0.30; white FM 1; flicker
@@ -293,7 +295,7 @@ def theo1(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     >>> import avar
     >>> res = avar.theo1([0.0, 1.0, 0.0, 2.0, 0.0, 1.0], data_type="phase", taus="all")
     >>> res.averaging_factors.tolist(), res.taus.tolist(), res.n.tolist()
-    ([2, 4], [1.5, 3.0], [4, 2])
+    ([2, 4], [1.5, 3.0], [4, 4])
     >>> res.deviation.round(6).tolist()
     [1.779513, 0.790569]
     """

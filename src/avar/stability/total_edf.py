@@ -9,11 +9,11 @@ name       terms n(m)              factors                    tau
 mtotdev    N - 3m + 1              1 .. floor(N / 3)          m tau0
 ttotdev    N - 3m + 1              1 .. floor(N / 3)          m tau0
 htotdev    N - 3m (m = 1: OHDEV)   1 .. floor((N - 1) / 3)    m tau0
-theo1      N - m                   even, 2 .. N - 1           0.75 m tau0
+theo1      (N - m) m / 2           even, 2 .. N - 1           0.75 m tau0
 =========  ======================  =========================  =====================
 
-(``allantools.theo1`` counts the (N - m) m / 2 inner terms and reports the tau
-as m tau0; the statistic is the same.)
+Theo1's count is that of its inner terms, as Stable32's ``Thêo1 #`` and
+``allantools`` (which reports the tau as m tau0; the statistic is the same).
 """
 
 from __future__ import annotations
@@ -41,7 +41,8 @@ TOTAL_LONG_NAMES = {
 MTOT_EDF = {2: (1.90, 2.10), 1: (1.20, 1.40), 0: (1.10, 1.20), -1: (0.85, 0.50), -2: (0.75, 0.31)}
 #: NIST SP 1065 (Howe et al. 2000): HTOTVAR EDF = (N / m) / (b0 + b1 m / N), for m >= 16.
 HTOT_EDF = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696)}
-#: Below this factor HTOTDEV's EDF is the Hadamard variance's (Stable32).
+#: Below this factor HTOTDEV's EDF is the overlapping Hadamard variance's (Stable32 switches
+#: here; its printed bounds below m = 16 are narrower than both Greenhall EDFs).
 HTOT_EDF_FROM = 16
 #: Howe et al. 2000: E[HTOTVAR] / HVAR = 1 + a (m > 1); Stable32 divides by it.
 HTOT_BIAS = {0: -0.005, -1: -0.149, -2: -0.229}
@@ -69,7 +70,7 @@ def term_counts(estimator: str, n_phase: int, factors: Any) -> np.ndarray:
     """Terms n(m) of every level without gaps, as in the table above.
 
     >>> term_counts("mtotdev", 100, np.array([1, 33])).tolist(), term_counts("theo1", 100, [2, 98]).tolist()
-    ([98, 2], [98, 2])
+    ([98, 2], [98, 98])
     """
     m = np.asarray(factors, dtype=np.int64)
     n = int(n_phase)
@@ -77,7 +78,7 @@ def term_counts(estimator: str, n_phase: int, factors: Any) -> np.ndarray:
         return n - 3 * m + 1
     if estimator == "htotdev":
         return n - 3 * m
-    return n - m
+    return (n - m) * (m // 2)
 
 
 def total_factors(estimator: str, n_phase: int, rate: float, taus: Any) -> np.ndarray:
@@ -119,8 +120,8 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
     """EDF of a total or Theo statistic at every level, floored at 1.
 
     * MTOTDEV, TTOTDEV (NIST SP 1065, Table 8): b N / m - c.
-    * HTOTDEV: the Hadamard variance's (Greenhall, non-overlapping) below m =
-      16 and for white and flicker PM; from m = 16 (Stable32)
+    * HTOTDEV: the overlapping Hadamard variance's (Greenhall) below m = 16
+      and for white and flicker PM; from m = 16 (Stable32)
       (N / m) / (b0 + b1 m / N) with (b0, b1) = (0.559, 1.004), (0.868,
       1.140), (0.938, 1.696) for alpha = 0, -1, -2.
     * Theo1 (Howe and Tasset 2004; NIST SP 1065, Table 11), r = 0.75 m:
@@ -148,7 +149,7 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
             b, c = MTOT_EDF[int(a)]
             edf[at] = b * n / mm - c
         elif estimator == "htotdev":
-            value = estimator_edf("hdev", np.full(mm.shape, a), mm.astype(np.int64), int(n_phase))
+            value = estimator_edf("ohdev", np.full(mm.shape, a), mm.astype(np.int64), int(n_phase))
             if int(a) in HTOT_EDF:
                 b0, b1 = HTOT_EDF[int(a)]
                 value = np.where(mm >= HTOT_EDF_FROM, (n / mm) / (b0 + b1 * mm / n), value)
