@@ -250,3 +250,30 @@ def test_stable32_htotdev_bounds_and_term_counts():
         assert term_counts(name, 1001, np.array(list(counts))).tolist() == list(counts.values())
     # Stable32's HTOTDEV of PHASE.DAT with and without its bias removal at m = 2 (alpha = 0):
     assert (2.0297e-01 / 2.0247e-01) ** 2 == pytest.approx(1 / 0.995, rel=5e-4)
+
+
+def test_theo1_by_fft_equals_the_direct_sum(monkeypatch):
+    from avar._kernels import theo_fft
+
+    rng = np.random.default_rng(11)
+    for x in (rng.standard_normal(3001), np.cumsum(rng.standard_normal(3001)),
+              np.cumsum(np.cumsum(rng.standard_normal(3001)))):
+        x = x - np.polyval(np.polyfit(np.arange(3001), x, 1), np.arange(3001))
+        prepared = (np.concatenate(([0.0], np.cumsum(x * x))), theo_fft.autocorrelation(x),
+                    np.ascontiguousarray(x[::-1]))
+        for m in (2, 300, 1026, 3000):
+            total, ratio = theo_fft.theo1_expanded(x, m, *prepared)
+            direct = theo1_sum(x, m, NO_GAPS, 0)[0]
+            assert total == pytest.approx(direct, rel=max(1e-13, 1e-14 * ratio)), (m, ratio)
+    triangle = theo_fft.triangle_sum(x, 3, 5, 700, np.arange(-800.0, 801.0), 800)
+    assert triangle == pytest.approx(sum((5 + q - 3 - p) * x[3 + p] * x[5 + q] for p in range(700)
+                                         for q in range(700 - p)), rel=1e-11)
+    monkeypatch.setattr(theo_fft, "DIRECT_TERMS", 0)  # every level by FFT, or direct where ill-conditioned
+    factors = np.array([2, 4, 64, 512, 2048])
+    sums, expanded = theo_fft.theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, NO_GAPS, 0)[0])
+    assert 0 < expanded < factors.size  # the random-walk-FM phase keeps its small levels direct
+    np.testing.assert_allclose(sums, [theo1_sum(x, m, NO_GAPS, 0)[0] for m in factors], rtol=1e-10)
+    y = rng.standard_normal(2000)
+    slow = avar.theo1(y)
+    monkeypatch.setattr(theo_fft, "DIRECT_TERMS", 0)
+    np.testing.assert_allclose(avar.theo1(y).deviation, slow.deviation, rtol=1e-10)

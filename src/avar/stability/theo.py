@@ -14,7 +14,8 @@ from typing import Any
 import numpy as np
 
 from avar._kernels.theo import oavar_sums, theo1_all
-from avar._kernels.total import level_sums
+from avar._kernels.theo_fft import theo1_sums
+from avar._kernels.total import theo1_sum
 from avar.stability.deviation_grids import deviation_factors
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, noise_exponents
@@ -128,7 +129,9 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     allan, theo = _levels(n_phase, rate, taus, k)
     unit = rate * rate if data_type == "phase" else 1.0
     avar = oavar_sums(x, allan) / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit
-    sums, counts = level_sums(2, x, theo, np.zeros(0, dtype=np.int64), 0)
+    no_gaps = np.zeros(0, dtype=np.int64)
+    sums = theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0)[0])[0]
+    counts = n_phase - theo
     theobr = kf * sums / (0.75 * counts * theo * theo) / scale / scale * unit
     factors = np.concatenate((allan, theo))
     if alpha is None:

@@ -15,7 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from avar._kernels.total import level_sums
+from avar._kernels.theo_fft import theo1_sums
+from avar._kernels.total import level_sums, theo1_sum
 from avar.stability.deviation_core import phase_parts
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options, noise_exponents
@@ -99,7 +100,11 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
 def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int,
                   scale: float, rate: float, is_phase: bool) -> tuple[np.ndarray, np.ndarray]:
     """Unbiased-as-defined variances and term counts (NaN where no term is left)."""
-    sums, counts = level_sums(_KIND[estimator], x, factors, bad, shift)
+    if estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
+        sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift)[0])[0]
+        counts = x.shape[0] - factors
+    else:
+        sums, counts = level_sums(_KIND[estimator], x, factors, bad, shift)
     m = factors.astype(np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         if estimator == "htotdev":
@@ -280,7 +285,9 @@ def theo1(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     tau = m tau0). :func:`avar.theoh` removes the bias from the data instead.
     The noise is identified at the factor 0.75 m by the OADEV rules; EDF:
     Howe and Tasset (see :func:`avar.stability.total_edf.total_edf`). Each
-    level costs O(N m / 2).
+    level costs O(N m / 2) directly; long levels of gap-free data are expanded into the
+    record's FFT autocorrelation and two end triangles (O(m log^2 m), see
+    :mod:`avar._kernels.theo_fft`) wherever that keeps 1e-11 relative accuracy.
     {parameters}
     References
     ----------
