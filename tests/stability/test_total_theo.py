@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import avar
-from avar._kernels.theo import oavar_sums, theo1_all
+from avar._kernels.theo import oavar_expanded, oavar_sums, theo1_all, theo1_ratio
+from avar._kernels.theo_fft import autocorrelation
 from avar._kernels.total import htot_sum, mtot_sum, theo1_sum
 from avar.stability.edf import estimator_edf
 from avar.stability.theo import theobr_factor
@@ -112,9 +113,14 @@ def test_kernels_match_the_plain_loops_on_larger_data():
 def test_theo1_all_factors_at_once_equals_the_direct_sum():
     for x in (RNG.standard_normal(121), np.cumsum(RNG.standard_normal(121)), np.cumsum(np.cumsum(RNG.standard_normal(121)))):
         x = x - np.polyval(np.polyfit(np.arange(121), x, 1), np.arange(121))
-        fast = theo1_all(x, 60)
+        fast = theo1_all(x, 60, np.zeros(0))
         direct = np.array([theo1_sum(x, 2 * k, NO_GAPS, 0)[0] for k in range(1, 61)])
         np.testing.assert_allclose(fast, direct, rtol=1e-9)
+        looked_up = theo1_all(x, 60, autocorrelation(x))
+        assert np.all(np.abs(looked_up / direct - 1) < 1e-15 * theo1_ratio(x, looked_up) * 60)
+        m = np.arange(1, 60)
+        sums, ratio = oavar_expanded(x, m, autocorrelation(x))
+        assert np.all(np.abs(sums / oavar_sums(x, m) - 1) < 1e-15 * ratio * 60)
 
 
 @pytest.mark.parametrize("name", ["mtotdev", "ttotdev", "htotdev", "theo1"])

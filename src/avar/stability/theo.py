@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from avar._kernels.theo import oavar_sums, theo1_all
-from avar._kernels.theo_fft import theo1_sums
+from avar._kernels.theo import oavar_expanded, oavar_sums, theo1_all, theo1_ratio
+from avar._kernels.theo_fft import MAX_RATIO, autocorrelation, theo1_sums
 from avar._kernels.total import theo1_sum
 from avar.stability.deviation_grids import deviation_factors
 from avar.stability.deviation_results import Deviation
@@ -37,9 +37,18 @@ def theobr_factor(x: np.ndarray) -> tuple[float, int]:
     n = int(np.floor(0.1 * n_points / 3.0)) - 3
     i = np.arange(n + 1, dtype=np.int64)
     m_avar = 9 + 3 * i
-    avar = oavar_sums(x, m_avar) / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
     m_theo = 12 + 4 * i
-    theo = theo1_all(x, int(m_theo[-1] // 2))[m_theo // 2 - 1] / (0.75 * (n_points - m_theo) * m_theo * m_theo)
+    autocorr = autocorrelation(x)  # lag sums by FFT; each sum is checked and redone directly if ill-conditioned
+    avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr)
+    redo = avar_ratio > MAX_RATIO
+    avar_sums[redo] = oavar_sums(x, m_avar[redo])
+    every = theo1_all(x, int(m_theo[-1] // 2), autocorr)
+    theo_sums = every[m_theo // 2 - 1]
+    no_gaps = np.zeros(0, dtype=np.int64)
+    for level in np.flatnonzero(theo1_ratio(x, every)[m_theo // 2 - 1] > MAX_RATIO):
+        theo_sums[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0]
+    avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
+    theo = theo_sums / (0.75 * (n_points - m_theo) * m_theo * m_theo)
     return float(np.mean(avar / theo)), n
 
 
