@@ -87,8 +87,10 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     :func:`avar.oadev`) below k, Theo1's even m (``taus`` as
     :func:`avar.theo1`, tau = 0.75 m tau0) from k. Each level's noise is
     identified by the OADEV rules (at 0.75 m for Theo1 levels) or fixed by
-    ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. kf costs O(N^2 / 15)
-    (Theo1 at every m = 2 .. N / 7.5 by Lewis's recurrence). ``n``: N - 2m
+    ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. kf needs Theo1 at every m = 2 .. N / 7.5
+    (Lewis's recurrence on the FFT autocorrelation, O(N^2 / 450)) and OAVAR at N / 30
+    factors; a sum whose expansion is ill-conditioned (random-walk FM at small m) is
+    summed directly, exactly but in O(N m). ``n``: N - 2m
     (OADEV), (N - m) m / 2 (Theo1, as Stable32). Dimensionless.
 
     Parameters
