@@ -4,6 +4,13 @@ Usage::
 
     python benchmarks/bench_deviations.py            # N = 1e5, 1e6, 1e7 (totdev up to 1e6)
     python benchmarks/bench_deviations.py --quick    # N = 1e5, 1e6, one repeat
+    python benchmarks/bench_deviations.py --total    # MTOTDEV, TTOTDEV, HTOTDEV, Theo1, ThêoH
+    python benchmarks/bench_deviations.py --total --sizes 1000 3000 100000
+
+``--total``: the total and Theo statistics (white FM, octave taus, no bias
+correction so that both compute the same numbers) against allantools, timed
+once per call (allantools is O(N^2) Python: 10 s for MTOTDEV at N = 3e3) up
+to ``--peer-max`` points, and ours alone beyond (ThêoH has no peer).
 
 Frequency data (white FM), ``taus="octave"`` on both sides (allantools is given
 our averaging times, so both compute the same levels). Columns:
@@ -31,6 +38,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import time
 import warnings
 
 import bench_catalogue  # benchmarks/bench_catalogue.py
@@ -88,11 +96,52 @@ def allantools_full(estimator: str, y: np.ndarray, taus: np.ndarray, rate: float
     return devs, bounds
 
 
+TOTAL = ("mtotdev", "ttotdev", "htotdev", "theo1", "theoh")
+
+
+def once(function) -> float:
+    """Wall time (s) of one call."""
+    start = time.perf_counter()
+    function()
+    return time.perf_counter() - start
+
+
+def bench_total(sizes: list[int], peer_max: int) -> None:
+    """Time the total and Theo statistics against allantools (up to ``peer_max`` points)."""
+    print("| statistic | N | levels | allantools (ms) | avar (ms) | avar vs allantools |")
+    print("|---|---|---|---|---|---|")
+    for n in sizes:
+        y = np.random.default_rng(0).standard_normal(n) * 1e-11
+        for name in TOTAL:
+            options = {} if name == "theoh" else {"bias_correction": False}
+            function = getattr(avar, name)
+            function(y[:1000], **options)  # numba compilation
+            results = []
+            ours = once(lambda: results.append(function(y, **options)))  # noqa: B023
+            levels = len(results[0])
+            peer = "-"
+            ratio = "-"
+            if allantools is not None and name != "theoh" and n <= peer_max:
+                factors = results[0].averaging_factors.astype(float)
+                at = getattr(allantools, name)
+                seconds = once(lambda: at(y, rate=1.0, data_type="freq", taus=factors))  # noqa: B023
+                peer, ratio = f"{seconds * 1e3:.0f}", f"{seconds / ours:.0f}x"
+            print(f"| {name} | {n:.0e} | {levels} | {peer} | {ours * 1e3:.1f} | {ratio} |",
+                  flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="N = 1e5 and 1e6, one repeat")
+    parser.add_argument("--total", action="store_true", help="the total and Theo statistics instead")
+    parser.add_argument("--sizes", type=int, nargs="+", default=[1000, 3000, 10000, 100000],
+                        help="N of --total (default 1e3 3e3 1e4 1e5)")
+    parser.add_argument("--peer-max", type=int, default=3000, help="largest N timed for allantools in --total")
     args = parser.parse_args()
     warnings.simplefilter("ignore")  # allantools' polyfit RankWarning on long series
+    if args.total:
+        bench_total(args.sizes, args.peer_max)
+        return
     sizes = [10**5, 10**6] if args.quick else [10**5, 10**6, 10**7]
     repeat = 1 if args.quick else 3
     print("| estimator | N | levels | allantools (ms) | allantools full (ms) | avar core (ms) | avar (ms) "

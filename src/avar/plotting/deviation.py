@@ -97,7 +97,7 @@ def plot_deviation(
                         label=f"{x.confidence:.3g} confidence (chi-squared)")
             drawn += [x.lci[valid], x.uci[valid]]
     if ylab is None:
-        ylab = f"{x.name} $\\sigma_x(\\tau)$ (s)" if x.estimator == "tdev" else f"{x.name} $\\sigma_y(\\tau)$"
+        ylab = f"{x.name} $\\sigma_x(\\tau)$ (s)" if x.estimator in ("tdev", "ttotdev") else f"{x.name} $\\sigma_y(\\tau)$"
     xlab = r"Averaging time $\tau$ (s)" if xlab is None else xlab
     title = f"{x.long_name.capitalize()} ({x.data_type} data)" if main is None else main
     finish(ax, xlab, ylab, title, legend, log_limits(*drawn))

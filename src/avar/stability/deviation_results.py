@@ -13,8 +13,14 @@ import pandas as pd
 
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
-from avar.stability.deviation_grids import ESTIMATORS, LONG_NAMES
+from avar.stability.deviation_grids import ESTIMATORS as _FAMILY
+from avar.stability.deviation_grids import LONG_NAMES as _FAMILY_NAMES
 from avar.stability.statistics import DEVIATION_STATISTICS, EXTRA_LONG_NAMES, PAIR_STATISTICS
+from avar.stability.total_edf import TOTAL_ESTIMATORS, TOTAL_LONG_NAMES
+
+#: Every estimator with its own variance core: the family and the total and Theo statistics.
+ESTIMATORS = (*_FAMILY, *TOTAL_ESTIMATORS)
+LONG_NAMES = {**_FAMILY_NAMES, **TOTAL_LONG_NAMES, **EXTRA_LONG_NAMES}
 
 #: Columns of :meth:`Deviation.summary`, in the order of Stable32's run table.
 SUMMARY_COLUMNS = ["Tau", "m", "N terms", "Alpha", "Min sigma", "Sigma", "Max sigma", "EDF"]
@@ -26,7 +32,9 @@ class Deviation:
 
     Build it with :func:`avar.adev`, :func:`avar.oadev`, :func:`avar.mdev`,
     :func:`avar.tdev`, :func:`avar.hdev`, :func:`avar.ohdev`,
-    :func:`avar.totdev`, :func:`avar.pdev`, :func:`avar.mtie`,
+    :func:`avar.totdev`, the total and Theo statistics :func:`avar.mtotdev`,
+    :func:`avar.ttotdev`, :func:`avar.htotdev`, :func:`avar.theo1` and
+    :func:`avar.theoh`, or :func:`avar.pdev`, :func:`avar.mtie`,
     :func:`avar.tierms`, :func:`avar.gcodev`, :func:`avar.three_cornered_hat`
     or :class:`avar.Stream`; the fields are read-only. MTIE, TIE rms and
     GCODEV carry no bounds (``edf``, ``lci``, ``uci`` NaN).

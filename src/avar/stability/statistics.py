@@ -13,6 +13,7 @@ from __future__ import annotations
 #: Public deviation functions of ``avar``, in the order the command line lists them.
 DEVIATION_STATISTICS = (
     "adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev",
+    "mtotdev", "ttotdev", "htotdev", "theo1", "theoh",
     "pdev", "mtie", "tierms",
 )
 

@@ -1,0 +1,164 @@
+"""ThêoH: the overlapping Allan deviation at short taus joined with bias-removed Theo1 (TheoBR) at long ones.
+
+Howe's hybrid (Howe 2006; Howe, Taylor and Tasset 2006), as Stable32 and
+NIST describe it: Theo1 reaches taus up to 0.75 (N - 1) tau0, 50 % beyond the
+Allan variance, but is biased against it by a factor that depends on the
+noise; TheoBR removes the bias with the data's own ratio of the two.
+"""
+
+from __future__ import annotations
+
+import numbers
+from typing import Any
+
+import numpy as np
+
+from avar._kernels.theo import oavar_expanded, oavar_sums, theo1_all, theo1_ratio
+from avar._kernels.theo_fft import MAX_RATIO, autocorrelation, theo1_sums
+from avar._kernels.total import theo1_sum
+from avar.stability.deviation_grids import deviation_factors
+from avar.stability.deviation_results import Deviation
+from avar.stability.deviations import DEFAULT_CONFIDENCE, noise_exponents
+from avar.stability.edf import chi2_bounds, estimator_edf
+from avar.stability.total import check_alpha, prepared_phase
+from avar.stability.total_edf import total_edf, total_factors
+
+#: Fewest phase points: TheoBR's average needs n = floor(N / 30) - 3 >= 0.
+MIN_THEOH_POINTS = 90
+
+
+def theobr_factor(x: np.ndarray) -> tuple[float, int]:
+    """TheoBR's bias factor kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(9 + 3i) / Theo1(12 + 4i),
+    n = floor(0.1 N / 3) - 3 (both at tau = (9 + 3i) tau0; AVAR overlapping), and n.
+
+    ``x``: gap-free phase, N >= 90 points. The units cancel in the ratio.
+    """
+    n_points = x.shape[0]
+    n = int(np.floor(0.1 * n_points / 3.0)) - 3
+    i = np.arange(n + 1, dtype=np.int64)
+    m_avar = 9 + 3 * i
+    m_theo = 12 + 4 * i
+    autocorr = autocorrelation(x)  # lag sums by FFT; each sum is checked and redone directly if ill-conditioned
+    avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr)
+    redo = avar_ratio > MAX_RATIO
+    avar_sums[redo] = oavar_sums(x, m_avar[redo])
+    every = theo1_all(x, int(m_theo[-1] // 2), autocorr)
+    theo_sums = every[m_theo // 2 - 1]
+    no_gaps = np.zeros(0, dtype=np.int64)
+    for level in np.flatnonzero(theo1_ratio(x, every)[m_theo // 2 - 1] > MAX_RATIO):
+        theo_sums[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0]
+    avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
+    theo = theo_sums / (0.75 * (n_points - m_theo) * m_theo * m_theo)
+    return float(np.mean(avar / theo)), n
+
+
+def _levels(n_phase: int, rate: float, taus: Any, k: float) -> tuple[np.ndarray, np.ndarray]:
+    """OADEV's factors below ``k`` samples and Theo1's (even m) at 0.75 m >= ``k``."""
+    if isinstance(taus, str):
+        allan = deviation_factors("oadev", n_phase, rate, taus)
+        theo = total_factors("theo1", n_phase, rate, taus)
+        return allan[allan < k], theo[0.75 * theo >= k]
+    try:
+        requested = np.atleast_1d(np.asarray(taus, dtype=np.float64))
+    except (TypeError, ValueError):
+        requested = np.zeros((0, 0))
+    if requested.ndim != 1 or requested.size == 0:
+        raise TypeError(f"taus must be 'octave', 'decade', 'all' or a non-empty 1-D array of averaging times (s), "
+                        f"got {taus!r}")
+    short = requested * rate < k
+    allan = deviation_factors("oadev", n_phase, rate, requested[short]) if short.any() else np.zeros(0, np.int64)
+    theo = total_factors("theo1", n_phase, rate, requested[~short]) if (~short).any() else np.zeros(0, np.int64)
+    return allan, theo
+
+
+def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
+          switch: float = 0.1) -> Deviation:
+    """ThêoH deviation: OADEV for tau < k, TheoBR for tau >= k, k = ``switch`` x N tau0::
+
+        ThêoH^2(tau) = sigma_y^2(tau)  (overlapping AVAR, tau = m tau0 < k)
+                     = kf Theo1(m)     (tau = 0.75 m tau0 >= k, m even <= N - 1)
+        kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i),  n = floor(N / 30) - 3,
+
+    N phase points. kf removes Theo1's bias against the Allan variance for any
+    noise mix without identifying it (TheoBR, Howe and Tasset 2004; Taylor
+    and Howe 2010 compute it decimated; this one is exact). The levels come
+    from the tau grid of each part: OADEV's factors m (``taus`` as
+    :func:`avar.oadev`) below k, Theo1's even m (``taus`` as
+    :func:`avar.theo1`, tau = 0.75 m tau0) from k. Each level's noise is
+    identified by the OADEV rules (at 0.75 m for Theo1 levels) or fixed by
+    ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. kf needs Theo1 at every m = 2 .. N / 7.5
+    (Lewis's recurrence on the FFT autocorrelation, O(N^2 / 450)) and OAVAR at N / 30
+    factors; a sum whose expansion is ill-conditioned (random-walk FM at small m) is
+    summed directly, exactly but in O(N m). ``n``: N - 2m
+    (OADEV), (N - m) m / 2 (Theo1, as Stable32). Dimensionless.
+
+    Parameters
+    ----------
+    data, rate, data_type, taus, confidence, alpha
+        As :func:`avar.theo1`.
+    nan_policy : {"raise", "omit"}
+        ThêoH needs gap-free data: NaN raises ``ValueError`` either way.
+    switch : float
+        k as a fraction of the record N tau0, in (0, 0.5]; 0.1 (the range of
+        Allan taus that TheoBR's kf averages over).
+
+    Returns
+    -------
+    Deviation
+        ``estimator="theoh"``.
+
+    References
+    ----------
+    D. A. Howe, "ThêoH: a hybrid, high-confidence statistic that improves on
+    the Allan deviation", Metrologia 43, S322, 2006. D. A. Howe, J. A. Taylor
+    and T. N. Tasset, "ThêoH bias-removal method", Proc. 2006 IEEE FCS.
+    W. J. Riley, NIST SP 1065, 2008, section 5.2.15.
+
+    Examples
+    --------
+    >>> import numpy as np, avar
+    >>> y = np.random.default_rng(0).standard_normal(1000)  # white FM
+    >>> res = avar.theoh(y)
+    >>> res.taus.tolist()
+    [1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 192.0, 384.0]
+    >>> res.n.tolist()[6:]  # N - 2m (OADEV), then (N - m) m / 2 (Theo1)
+    [873, 95360, 125184]
+    """
+    alpha = check_alpha(alpha)
+    if isinstance(switch, (bool, np.bool_)) or not isinstance(switch, numbers.Real) or not 0.0 < switch <= 0.5:
+        raise ValueError(f"switch must be a fraction of the record in (0, 0.5], e.g. 0.1, got {switch!r}")
+    values, rate, x, bad, _, scale, n_phase = prepared_phase("theoh", data, rate, data_type, confidence, nan_policy)
+    if bad.size:
+        missing = np.flatnonzero(np.isnan(values))
+        raise ValueError(f"data has {missing.size} NaN value(s), the first at index {missing[0]}; theoh needs "
+                         "gap-free data (fill or cut them, or use theo1/oadev with nan_policy='omit')")
+    if n_phase < MIN_THEOH_POINTS:
+        raise ValueError(f"data has {values.size} sample(s); theoh needs at least {MIN_THEOH_POINTS} phase points "
+                         f"(TheoBR averages AVAR/Theo1 over floor(N / 30) - 2 taus)")
+    kf, _ = theobr_factor(x)
+    k = float(switch) * n_phase  # in samples
+    allan, theo = _levels(n_phase, rate, taus, k)
+    unit = rate * rate if data_type == "phase" else 1.0
+    avar = oavar_sums(x, allan) / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit
+    no_gaps = np.zeros(0, dtype=np.int64)
+    sums = theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0)[0])[0]
+    counts = n_phase - theo
+    theobr = kf * sums / (0.75 * counts * theo * theo) / scale / scale * unit
+    factors = np.concatenate((allan, theo))
+    if alpha is None:
+        ident = np.concatenate((allan, np.maximum(1, np.round(0.75 * theo)).astype(np.int64)))
+        alphas = noise_exponents("oadev", values, data_type, rate, ident)
+    else:
+        alphas = np.full(factors.size, alpha, dtype=np.int64)
+    edf = np.concatenate((estimator_edf("oadev", alphas[: allan.size], allan, n_phase),
+                          total_edf("theo1", alphas[allan.size :], theo, n_phase)))
+    variance = np.concatenate((avar, theobr))
+    if not np.all(np.isfinite(variance)):
+        raise ValueError("theoh overflows float64; rescale the data, e.g. to other units")
+    deviation = np.sqrt(variance)
+    lci, uci = chi2_bounds(deviation, edf, float(confidence))
+    return Deviation(taus=np.concatenate((allan, 0.75 * theo)) / rate, averaging_factors=factors, deviation=deviation,
+                     variance=variance, n=np.concatenate((n_phase - 2 * allan, counts * (theo // 2))), alpha=alphas, edf=edf,
+                     lci=lci, uci=uci, estimator="theoh", data_type=data_type, rate=rate, n_samples=values.size,
+                     confidence=float(confidence))

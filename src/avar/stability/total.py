@@ -1,0 +1,315 @@
+"""The total and Theo statistics: MTOTDEV, TTOTDEV, HTOTDEV and Theo1.
+
+Defined as in NIST SP 1065 (Riley 2008) and Stable32, with the signature and
+:class:`~avar.stability.deviation_results.Deviation` result of
+:func:`avar.adev` ... :func:`avar.totdev` (see :mod:`avar.stability.deviations`
+for the shared conventions: frequency data become phase x = (0, cumsum(y))
+tau0, NaN gaps, confidence), plus ``alpha`` to fix the noise type and
+``bias_correction``. The variances come from the kernels of
+:mod:`avar._kernels.total`; levels, EDF and bias from :mod:`avar.stability.total_edf`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from avar._kernels.theo_fft import theo1_sums
+from avar._kernels.total import level_sums, theo1_sum
+from avar.stability.deviation_core import phase_parts
+from avar.stability.deviation_results import Deviation
+from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options, noise_exponents
+from avar.stability.edf import chi2_bounds
+from avar.stability.total_edf import (
+    MTOT_EDF,
+    htot_bias,
+    largest_factor,
+    term_counts,
+    theo1_bias,
+    total_edf,
+    total_factors,
+)
+
+#: MTOTVAR / MVAR per noise type (Howe and Vernotte 1999; Riley, "CI2"), applied on request only.
+MTOT_BIAS = {2: 0.94, 1: 0.83, 0: 0.73, -1: 0.70, -2: 0.69}
+_KIND = {"mtotdev": 0, "ttotdev": 0, "htotdev": 1, "theo1": 2}
+#: The deviation whose noise identification rules each statistic follows.
+_NOISE_RULES = {"mtotdev": "mdev", "ttotdev": "tdev", "htotdev": "ohdev", "theo1": "oadev"}
+_MIN_PHASE = {"mtotdev": 3, "ttotdev": 3, "htotdev": 4, "theo1": 3}
+
+_PARAMETERS = """
+    Parameters
+    ----------
+    data : array_like or pandas.Series
+        1-D fractional frequency y (``data_type="freq"``) or phase x in
+        seconds (``"phase"``); NaN marks a gap (see ``nan_policy``).
+    rate : float
+        Sampling rate in Hz; tau0 = 1 / rate.
+    data_type : {"freq", "phase"}
+    taus : {"octave", "decade", "all"} or array_like of float
+        Averaging times (see :func:`avar.stability.total_edf.total_factors`).
+    confidence : float
+        Two-sided confidence level of ``lci``/``uci`` in (0, 1); 0.683 as Stable32.
+    nan_policy : {"raise", "omit"}
+        ``"omit"``: every term (window) touching a gap is skipped; ``n`` counts
+        the terms used and the EDF is scaled by the fraction used.
+    alpha : int or None
+        The power-law noise exponent (2 white PM .. -2 random-walk FM) of every
+        level, as Stable32's fixed noise type; None identifies it per level
+        (:func:`avar.stability.noise_id.identify_noise`).
+
+    Returns
+    -------
+    Deviation
+"""
+
+
+def check_alpha(alpha: Any) -> int | None:
+    """None or an integer noise exponent in -2 .. 2, or an error naming ``alpha``."""
+    if alpha is None:
+        return None
+    if isinstance(alpha, (bool, np.bool_)) or not isinstance(alpha, (int, np.integer)):
+        raise TypeError(f"alpha must be None or an integer in -2 .. 2 (the noise exponent), got {alpha!r}")
+    if not -2 <= int(alpha) <= 2:
+        raise ValueError(f"alpha must be in -2 .. 2 (2 white PM, 1 flicker PM, 0 white FM, -1 flicker FM, "
+                         f"-2 random-walk FM), got {int(alpha)}")
+    return int(alpha)
+
+
+def _check_bias(bias_correction: Any) -> bool:
+    if not isinstance(bias_correction, (bool, np.bool_)):
+        raise TypeError(f"bias_correction must be True or False, got {bias_correction!r}")
+    return bool(bias_correction)
+
+
+def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confidence: Any, nan_policy: Any):
+    """Validate once: ``values, rate, x, bad, shift, scale, n_phase``; ``x`` the detrended phase
+    (scaled by ``scale``, a power of two; HTOTDEV: its linear frequency drift removed too, as
+    every statistic here is blind to it) with gaps filled, ``bad`` their prefix count."""
+    rate = _check_options(estimator, rate, data_type, confidence, nan_policy)
+    values, scanned = _check_data(data, data_type, nan_policy)
+    needed = _MIN_PHASE.get(estimator, 3) - (data_type == "freq")
+    if values.size < needed:
+        raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
+    x, _, scale, _, bad, _, _ = phase_parts(values, data_type, "ohdev" if estimator == "htotdev" else "oadev", scanned)
+    bad = np.zeros(0, dtype=np.int64) if bad is None else np.ascontiguousarray(bad, dtype=np.int64)
+    return values, rate, np.ascontiguousarray(x), bad, int(data_type == "freq"), scale, values.size + (data_type == "freq")
+
+
+def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int,
+                  scale: float, rate: float, is_phase: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Unbiased-as-defined variances and term counts (NaN where no term is left)."""
+    if estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
+        sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift)[0])[0]
+        counts = x.shape[0] - factors
+    else:
+        sums, counts = level_sums(_KIND[estimator], x, factors, bad, shift)
+    m = factors.astype(np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if estimator == "htotdev":
+            variance = sums / (6.0 * counts)
+            if factors.size and factors[0] == 1:  # NIST, Stable32: OHDEV at m = 1
+                variance[0], counts[0] = _ohvar1(x, bad, shift)
+        elif estimator == "theo1":
+            variance = sums / (0.75 * counts * m * m)
+            counts = counts * (factors // 2)  # Stable32's count: the inner terms
+        else:
+            variance = sums / (2.0 * m * m * counts)
+        variance = variance / scale / scale * (rate * rate if is_phase else 1.0)
+    variance[counts == 0] = np.nan
+    return variance, counts
+
+
+def _ohvar1(x: np.ndarray, bad: np.ndarray, shift: int) -> tuple[float, int]:
+    """The overlapping Hadamard variance at m = 1 (in the units of ``x`` per sample)."""
+    third = x[3:] - 3.0 * x[2:-1] + 3.0 * x[1:-2] - x[:-3]
+    if bad.size:
+        third = third[bad[4 - shift :] - bad[: third.size] == 0]
+    if third.size == 0:
+        return np.nan, 0
+    return float(third @ third / (6.0 * third.size)), int(third.size)
+
+
+def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, confidence: Any, nan_policy: Any,
+             alpha: Any, bias_correction: Any) -> Deviation:
+    """Validate, compute the variances, identify the noise, correct the bias, bound the deviation."""
+    alpha = check_alpha(alpha)
+    bias = _check_bias(bias_correction)
+    values, rate, x, bad, shift, scale, n_phase = prepared_phase(estimator, data, rate, data_type, confidence,
+                                                                 nan_policy)
+    factors = total_factors(estimator, n_phase, rate, taus)
+    if factors.size == 0:
+        raise ValueError(f"data has too few points for any {estimator} level (largest factor "
+                         f"{largest_factor(estimator, n_phase)})")
+    variance, n = raw_variances(estimator, x, factors, bad, shift, scale, rate, data_type == "phase")
+    if bad.size:
+        keep = n > 0
+        if not keep.any():
+            raise ValueError(f"no {estimator} term avoids the NaN values of data at these taus")
+        factors, variance, n = factors[keep], variance[keep], n[keep]
+    if not np.all(np.isfinite(variance)):
+        raise ValueError(f"{estimator} overflows float64; rescale the data, e.g. to other units")
+    if alpha is None:
+        noise_factors = np.maximum(1, np.round(0.75 * factors)).astype(np.int64) if estimator == "theo1" else factors
+        alphas = noise_exponents(_NOISE_RULES[estimator], values, data_type, rate, noise_factors)
+    else:
+        alphas = np.full(factors.size, alpha, dtype=np.int64)
+    if bias:
+        variance = correct_bias(estimator, variance, alphas, factors)
+    tau = (0.75 * factors if estimator == "theo1" else factors) / rate
+    if estimator == "ttotdev":
+        variance = variance * tau * tau / 3.0
+    edf = total_edf(estimator, alphas, factors, n_phase)
+    if bad.size:
+        edf = np.maximum(edf * n / term_counts(estimator, n_phase, factors), 1.0)
+    deviation = np.sqrt(variance)
+    lci, uci = chi2_bounds(deviation, edf, float(confidence))
+    return Deviation(taus=tau, averaging_factors=factors, deviation=deviation, variance=variance, n=n, alpha=alphas,
+                     edf=edf, lci=lci, uci=uci, estimator=estimator, data_type=data_type, rate=rate,
+                     n_samples=values.size, confidence=float(confidence))
+
+
+def correct_bias(estimator: str, variance: np.ndarray, alpha: np.ndarray, factors: np.ndarray) -> np.ndarray:
+    """Stable32's bias removal: HTOTVAR / (1 + a), Theo1 x AVAR/Theo1, MTOTVAR / (its MVAR ratio)."""
+    if estimator == "htotdev":
+        return variance / htot_bias(alpha, factors)
+    if estimator == "theo1":
+        return variance * theo1_bias(alpha, factors)
+    return variance / np.array([MTOT_BIAS[int(a)] for a in alpha])
+
+
+def mtotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+            confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
+            bias_correction: bool = False) -> Deviation:
+    """Modified total deviation, NIST SP 1065 eq. (27)::
+
+        Mod Tot var(tau) = 1 / (2 tau^2 (N - 3m + 1)) sum_{n=0}^{N-3m} [1 / (6m) sum_{j=0}^{6m-1} z_j(n)^2],
+
+    with z_j(n) = (A_j - 2 B_j + C_j) / m the second difference of three
+    adjacent m-point phase averages of x*(n): the 3m-point window x_n ..
+    x_{n+3m-1} less the line through the means of its halves, extended at both
+    ends by uninverted even reflection to 9m points. tau = m tau0, m = 1 .. N / 3,
+    n = N - 3m + 1 terms. Dimensionless. EDF: b N / m - c (NIST SP 1065 Table 8).
+    ``bias_correction=True`` divides by MTOTVAR / MVAR (0.94, 0.83, 0.73, 0.70,
+    0.69 for alpha = 2 .. -2); Stable32 and ``allantools`` do not (default False).
+    Each level costs O(N m).
+    {parameters}
+    References
+    ----------
+    D. A. Howe and F. Vernotte, "Generalization of the total variance approach
+    to the modified Allan variance", Proc. 31st PTTI, 1999. W. J. Riley, NIST
+    SP 1065, 2008, section 5.2.12.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.mtotdev([0.0, 1.0, 0.0, 2.0, 0.0, 1.0], data_type="phase", taus="all")
+    >>> res.n.tolist(), res.deviation.round(6).tolist()
+    ([4, 1], [1.541104, 0.220625])
+    """
+    return estimate("mtotdev", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
+
+
+def ttotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+            confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
+            bias_correction: bool = False) -> Deviation:
+    """Time total deviation, NIST SP 1065 eq. (28): sigma_x^2(tau) = tau^2 / 3 Mod Tot var(tau), in seconds.
+
+    Same terms, levels, noise identification and EDF as :func:`mtotdev`.
+    {parameters}
+    References
+    ----------
+    W. J. Riley, NIST SP 1065, 2008, section 5.2.13 (its tau^3 is a misprint for tau^2).
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.ttotdev([0.0, 1.0, 0.0, 2.0, 0.0, 1.0], rate=2.0, data_type="phase", taus="all")
+    >>> res.taus.tolist(), res.deviation.round(6).tolist()  # 0.5 s / sqrt(3) * MTOTDEV
+    ([0.5, 1.0], [0.889757, 0.254756])
+    """
+    return estimate("ttotdev", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
+
+
+def htotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+            confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
+            bias_correction: bool = True) -> Deviation:
+    """Hadamard total deviation, NIST SP 1065 eq. (29)::
+
+        Htot var(tau) = 1 / (6 (M - 3m + 1)) sum_{n=0}^{M-3m} [1 / (6m) sum_{j=0}^{6m-1} H_j(n)^2],
+
+    on the M = N - 1 fractional frequencies y, with H_j(n) = ybar_j - 2
+    ybar_{j+m} + ybar_{j+2m} of m-point averages of y*(n): the window y_n ..
+    y_{n+3m-1} less the line through the means of its halves, extended by
+    uninverted even reflection to 9m points. At m = 1 the overlapping Hadamard
+    variance is used (NIST, Stable32). n = N - 3m terms, m = 1 .. (N - 1) / 3.
+    Insensitive to a linear frequency drift. Dimensionless.
+    ``bias_correction=True`` (default, Stable32) divides by E[Htot var] / Hvar
+    = 1 + a for m > 1, a = -0.005, -0.149, -0.229 for alpha = 0, -1, -2 (none
+    for PM noise); ``allantools`` applies none. EDF: the Hadamard variance's
+    below m = 16, then (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`),
+    which equals Stable32's printed bounds from m = 16.
+    {parameters}
+    References
+    ----------
+    D. A. Howe, R. L. Beard, C. A. Greenhall, F. Vernotte and W. J. Riley, "A
+    total estimator of the Hadamard function used for GPS operations", Proc.
+    32nd PTTI, 2000. W. J. Riley, NIST SP 1065, 2008, section 5.2.14.
+
+    Examples
+    --------
+    >>> import avar
+    >>> y = [1.0, 3.0, 2.0, 5.0, 3.0, 4.0, 6.0]
+    >>> res = avar.htotdev(y, taus="all", bias_correction=False)
+    >>> res.n.tolist(), res.deviation.round(6).tolist()
+    ([5, 2], [1.414214, 0.584984])
+    """
+    return estimate("htotdev", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
+
+
+def theo1(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
+          bias_correction: bool = False) -> Deviation:
+    """Theo1 deviation, NIST SP 1065 eq. (30), at tau = 0.75 m tau0 with m even::
+
+        Theo1(m) = 1 / (0.75 (N - m) (m tau0)^2) sum_{i=0}^{N-m-1} sum_{d=0}^{m/2-1}
+                   [(x_i - x_{i-d+m/2}) + (x_{i+m} - x_{i+d+m/2})]^2 / (m/2 - d),
+
+    m = 2, 4, ... <= N - 1, n = (N - m) m / 2 terms (Stable32's ``Thêo1 #``). Dimensionless. Unbiased
+    against the Allan variance for white FM only: ``bias_correction=True``
+    multiplies by AVAR / Theo1 = a + b / r^c, r = 0.75 m (Howe and Tasset 2004;
+    white PM 0.09, 0.74, 0.40; flicker PM 0.14, 0.82, 0.30; white FM 1; flicker
+    FM 1.87, -1.05, 0.79; random-walk FM 2.70, -1.53, 0.85); the default is
+    the raw statistic, as NIST SP 1065 and ``allantools`` (which reports it at
+    tau = m tau0). :func:`avar.theoh` removes the bias from the data instead.
+    The noise is identified at the factor 0.75 m by the OADEV rules; EDF:
+    Howe and Tasset (see :func:`avar.stability.total_edf.total_edf`). Each
+    level costs O(N m / 2) directly; long levels of gap-free data are expanded into the
+    record's FFT autocorrelation and two end triangles (O(m log^2 m), see
+    :mod:`avar._kernels.theo_fft`) wherever that keeps 1e-11 relative accuracy.
+    {parameters}
+    References
+    ----------
+    D. A. Howe and T. K. Peppler, "Very long-term frequency stability:
+    estimation using a special-purpose statistic", Proc. 2003 IEEE FCS. D. A.
+    Howe and T. N. Tasset, "Theo1: characterization of very long-term
+    frequency stability", Proc. 18th EFTF, 2004. W. J. Riley, NIST SP 1065,
+    2008, section 5.2.15.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.theo1([0.0, 1.0, 0.0, 2.0, 0.0, 1.0], data_type="phase", taus="all")
+    >>> res.averaging_factors.tolist(), res.taus.tolist(), res.n.tolist()
+    ([2, 4], [1.5, 3.0], [4, 4])
+    >>> res.deviation.round(6).tolist()
+    [1.779513, 0.790569]
+    """
+    return estimate("theo1", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
+
+
+for _function in (mtotdev, ttotdev, htotdev, theo1):
+    _function.__doc__ = _function.__doc__.replace("{parameters}", _PARAMETERS)
+del _function
+assert set(MTOT_EDF) == set(MTOT_BIAS)

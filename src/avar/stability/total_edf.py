@@ -1,0 +1,196 @@
+"""Levels, EDF and bias of the total and Theo statistics: MTOTDEV, TTOTDEV, HTOTDEV, Theo1, ThêoH.
+
+N is the number of phase points (frequency data of M values give N = M + 1)
+and m the averaging factor. Term counts, as NIST SP 1065 (Riley 2008):
+
+=========  ======================  =========================  =====================
+name       terms n(m)              factors                    tau
+=========  ======================  =========================  =====================
+mtotdev    N - 3m + 1              1 .. floor(N / 3)          m tau0
+ttotdev    N - 3m + 1              1 .. floor(N / 3)          m tau0
+htotdev    N - 3m (m = 1: OHDEV)   1 .. floor((N - 1) / 3)    m tau0
+theo1      (N - m) m / 2           even, 2 .. N - 1           0.75 m tau0
+=========  ======================  =========================  =====================
+
+Theo1's count is that of its inner terms, as Stable32's ``Thêo1 #`` and
+``allantools`` (which reports the tau as m tau0; the statistic is the same).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from avar._validation import short_repr
+from avar.stability.edf import estimator_edf
+from avar.stability.grids import grid_factors
+
+TOTAL_ESTIMATORS = ("mtotdev", "ttotdev", "htotdev", "theo1", "theoh")
+
+#: Long names, for labels and summaries.
+TOTAL_LONG_NAMES = {
+    "mtotdev": "modified total deviation",
+    "ttotdev": "time total deviation",
+    "htotdev": "Hadamard total deviation",
+    "theo1": "Theo1 deviation",
+    "theoh": "ThêoH deviation (OADEV and bias-removed Theo1)",
+}
+
+#: NIST SP 1065 Table 8: MTOTVAR (and TTOTVAR) EDF = b N / m - c.
+MTOT_EDF = {2: (1.90, 2.10), 1: (1.20, 1.40), 0: (1.10, 1.20), -1: (0.85, 0.50), -2: (0.75, 0.31)}
+#: NIST SP 1065 (Howe et al. 2000): HTOTVAR EDF = (N / m) / (b0 + b1 m / N), for m >= 16.
+HTOT_EDF = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696)}
+#: Below this factor HTOTDEV's EDF is the overlapping Hadamard variance's (Stable32 switches
+#: here; its printed bounds below m = 16 are narrower than both Greenhall EDFs).
+HTOT_EDF_FROM = 16
+#: Howe et al. 2000: E[HTOTVAR] / HVAR = 1 + a (m > 1); Stable32 divides by it.
+HTOT_BIAS = {0: -0.005, -1: -0.149, -2: -0.229}
+#: Howe and Tasset 2004, Table 1: AVAR / Theo1 = a + b / r**c, r = 0.75 m.
+THEO1_BIAS = {2: (0.09, 0.74, 0.40), 1: (0.14, 0.82, 0.30), 0: (1.0, 0.0, 0.0), -1: (1.87, -1.05, 0.79),
+              -2: (2.70, -1.53, 0.85)}
+
+
+def largest_factor(estimator: str, n_phase: int) -> int:
+    """Largest averaging factor with one term (0 if none).
+
+    >>> [largest_factor(e, 1001) for e in ("mtotdev", "htotdev", "theo1")]
+    [333, 333, 1000]
+    """
+    n = int(n_phase)
+    if estimator in ("mtotdev", "ttotdev"):
+        return max(0, n // 3)
+    if estimator == "htotdev":
+        return max(0, (n - 1) // 3)
+    largest = n - 1
+    return max(0, largest - largest % 2)
+
+
+def term_counts(estimator: str, n_phase: int, factors: Any) -> np.ndarray:
+    """Terms n(m) of every level without gaps, as in the table above.
+
+    >>> term_counts("mtotdev", 100, np.array([1, 33])).tolist(), term_counts("theo1", 100, [2, 98]).tolist()
+    ([98, 2], [98, 98])
+    """
+    m = np.asarray(factors, dtype=np.int64)
+    n = int(n_phase)
+    if estimator in ("mtotdev", "ttotdev"):
+        return n - 3 * m + 1
+    if estimator == "htotdev":
+        return n - 3 * m
+    return (n - m) * (m // 2)
+
+
+def total_factors(estimator: str, n_phase: int, rate: float, taus: Any) -> np.ndarray:
+    """Averaging factors of a tau grid (see :func:`avar.stability.grids.grid_factors`).
+
+    Theo1 (and ThêoH's Theo1 levels) take even m only, tau = 0.75 m tau0:
+    ``"octave"`` m = 2, 4, 8, ...; ``"decade"`` the even ones of 1, 2, 4 x
+    10**k; ``"all"`` every even m; explicit taus in seconds give m = tau /
+    (0.75 tau0), which must be a whole even number.
+
+    >>> total_factors("theo1", 100, 1.0, "octave").tolist(), total_factors("theo1", 100, 1.0, [1.5, 3.0]).tolist()
+    ([2, 4, 8, 16, 32, 64], [2, 4])
+    """
+    largest = largest_factor(estimator, n_phase)
+    context = f"of {estimator} with {n_phase} phase points at rate = {rate:g} Hz"
+    if estimator != "theo1":
+        return grid_factors(taus, rate, largest, first_octave=0, context=f"{context} (m = 1..{largest})")
+    if largest < 2:
+        return np.zeros(0, dtype=np.int64)
+    if isinstance(taus, str):
+        if taus.lower() == "octave":
+            return 2 ** np.arange(1, largest.bit_length(), dtype=np.int64)
+        factors = grid_factors(taus, rate, largest, first_octave=1, context=context)
+        return factors[(factors % 2 == 0)]
+    try:
+        scaled = np.asarray(taus, dtype=np.float64) / 0.75
+    except (TypeError, ValueError):
+        scaled = taus  # grid_factors names what is wrong
+    exact = grid_factors(scaled, rate, largest, first_octave=1, context=f"{context} (tau = 0.75 m / rate, m even)")
+    requested = np.atleast_1d(scaled) * rate
+    odd = (np.abs(requested - np.round(requested)) > 1e-9 * requested) | (np.round(requested) % 2 == 1)
+    if odd.any():
+        raise ValueError(f"theo1 taus must be 0.75 m / rate with m even, got {short_repr((requested[odd] * 0.75 / rate).tolist())} "
+                         f"s (m = {short_repr(requested[odd].tolist())})")
+    return exact
+
+
+def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: int) -> np.ndarray:
+    """EDF of a total or Theo statistic at every level, floored at 1.
+
+    * MTOTDEV, TTOTDEV (NIST SP 1065, Table 8): b N / m - c.
+    * HTOTDEV: the overlapping Hadamard variance's (Greenhall) below m = 16
+      and for white and flicker PM; from m = 16 (Stable32)
+      (N / m) / (b0 + b1 m / N) with (b0, b1) = (0.559, 1.004), (0.868,
+      1.140), (0.938, 1.696) for alpha = 0, -1, -2.
+    * Theo1 (Howe and Tasset 2004; NIST SP 1065, Table 11), r = 0.75 m:
+      alpha = 2: 0.86 (N + 1)(N - 4r/3) / (N - r) * r / (r + 1.14);
+      1: (4.798 N**2 - 6.374 N r + 12.387 r) / (sqrt(r + 36.6) (N - r)) * r / (r + 0.3);
+      0: ((4.1 N + 0.8) / r - (3.1 N + 6.5) / N) * r**1.5 / (r**1.5 + 5.2);
+      -1: (2 N**2 - 1.3 N r - 3.5 r) / (N r) * r**3 / (r**3 + 2.3);
+      -2: (4.4 N - 2) / (2.9 r) * ((4.4 N - 1)**2 - 8.6 r (4.4 N - 1) + 11.4 r**2) / (4.4 N - 3)**2.
+
+    Examples
+    --------
+    >>> total_edf("mtotdev", np.array([0, -2]), np.array([10, 10]), 1001).round(3).tolist()
+    [108.91, 74.765]
+    >>> total_edf("theo1", np.array([0]), np.array([100]), 1001).round(3).tolist()
+    [51.215]
+    """
+    alpha = np.asarray(alpha, dtype=np.int64)
+    m = np.asarray(factors, dtype=np.float64)
+    n = float(n_phase)
+    edf = np.ones(m.shape)
+    for a in np.unique(alpha):
+        at = alpha == a
+        mm = m[at]
+        if estimator in ("mtotdev", "ttotdev"):
+            b, c = MTOT_EDF[int(a)]
+            edf[at] = b * n / mm - c
+        elif estimator == "htotdev":
+            value = estimator_edf("ohdev", np.full(mm.shape, a), mm.astype(np.int64), int(n_phase))
+            if int(a) in HTOT_EDF:
+                b0, b1 = HTOT_EDF[int(a)]
+                value = np.where(mm >= HTOT_EDF_FROM, (n / mm) / (b0 + b1 * mm / n), value)
+            edf[at] = value
+        else:
+            edf[at] = _theo1_edf(int(a), n, 0.75 * mm)
+    return np.where(np.isfinite(edf) & (edf >= 1.0), edf, 1.0)
+
+
+def _theo1_edf(alpha: int, n: float, r: np.ndarray) -> np.ndarray:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if alpha == 2:
+            return 0.86 * (n + 1) * (n - 4 * r / 3) / (n - r) * r / (r + 1.14)
+        if alpha == 1:
+            return (4.798 * n * n - 6.374 * n * r + 12.387 * r) / (np.sqrt(r + 36.6) * (n - r)) * r / (r + 0.3)
+        if alpha == 0:
+            return ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * r**1.5 / (r**1.5 + 5.2)
+        if alpha == -1:
+            return (2 * n * n - 1.3 * n * r - 3.5 * r) / (n * r) * r**3 / (r**3 + 2.3)
+        return (4.4 * n - 2) / (2.9 * r) * ((4.4 * n - 1) ** 2 - 8.6 * r * (4.4 * n - 1) + 11.4 * r * r) / (4.4 * n - 3) ** 2
+
+
+def htot_bias(alpha: np.ndarray, factors: np.ndarray) -> np.ndarray:
+    """E[HTOTVAR] / HVAR per level: 1 + a(alpha) for m > 1 (alpha = 0, -1, -2), else 1.
+
+    >>> htot_bias(np.array([0, -1, -2, -1]), np.array([2, 2, 2, 1])).tolist()
+    [0.995, 0.851, 0.771, 1.0]
+    """
+    a = np.array([HTOT_BIAS.get(int(v), 0.0) for v in np.asarray(alpha).ravel()])
+    return np.where(np.asarray(factors) > 1, 1.0 + a, 1.0)
+
+
+def theo1_bias(alpha: np.ndarray, factors: np.ndarray) -> np.ndarray:
+    """AVAR / Theo1 per level: a + b / r**c with r = 0.75 m (Howe and Tasset 2004, Table 1).
+
+    >>> theo1_bias(np.array([2, 0, -2]), np.array([10, 10, 10])).round(4).tolist()
+    [0.4205, 1.0, 2.424]
+    """
+    r = 0.75 * np.asarray(factors, dtype=np.float64)
+    out = np.empty(r.shape)
+    for i, a in enumerate(np.asarray(alpha).ravel()):
+        a0, b, c = THEO1_BIAS[int(a)]
+        out[i] = a0 + b / r[i] ** c
+    return out

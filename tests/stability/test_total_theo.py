@@ -1,0 +1,285 @@
+"""MTOTDEV, TTOTDEV, HTOTDEV, Theo1 and ThêoH against plain loops over NIST SP 1065, allantools and theory."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import allantools
+import numpy as np
+import pytest
+
+import avar
+from avar._kernels.theo import oavar_expanded, oavar_sums, theo1_all, theo1_ratio
+from avar._kernels.theo_fft import autocorrelation
+from avar._kernels.total import htot_sum, mtot_sum, theo1_sum
+from avar.stability.edf import estimator_edf
+from avar.stability.theo import theobr_factor
+from avar.stability.total_edf import total_edf, total_factors
+
+NO_GAPS = np.zeros(0, dtype=np.int64)
+
+
+def reflected_total(window: list, m: int) -> Fraction:
+    """(1 / 6m) sum_j ((A_j - 2 B_j + C_j) / m)^2 of one 3m-point window, detrended by the
+    means of its halves and reflected to 9m points: a plain loop over NIST SP 1065's recipe."""
+    span = 3 * m
+    half = span // 2
+    gap = span - half
+    slope = (sum(window[gap:]) - sum(window[:half])) / half / gap
+    w = [window[k] - slope * k for k in range(span)]
+    star = w[::-1] + w + w[::-1]
+    total = Fraction(0)
+    for j in range(6 * m):
+        a = sum(star[j : j + m])
+        b = sum(star[j + m : j + 2 * m])
+        c = sum(star[j + 2 * m : j + 3 * m])
+        total += ((a - 2 * b + c) / m) ** 2
+    return total / (6 * m)
+
+
+def plain_mtotvar(x: list, m: int) -> Fraction:
+    """NIST SP 1065 eq. (27) in exact arithmetic (tau0 = 1)."""
+    n = len(x) - 3 * m + 1
+    return sum(reflected_total(x[i : i + 3 * m], m) for i in range(n)) / (2 * m * m * n)
+
+
+def plain_htotvar(y: list, m: int) -> Fraction:
+    """NIST SP 1065 eq. (29) on frequency data, exact."""
+    n = len(y) - 3 * m + 1
+    return sum(reflected_total(y[i : i + 3 * m], m) for i in range(n)) / (6 * n)
+
+
+def plain_theo1(x: list, m: int) -> Fraction:
+    """NIST SP 1065 eq. (30), exact (tau0 = 1)."""
+    n, h = len(x), m // 2
+    total = Fraction(0)
+    for i in range(n - m):
+        for d in range(h):
+            total += ((x[i] - x[i - d + h]) + (x[i + m] - x[i + d + h])) ** 2 / Fraction(h - d)
+    return total / (Fraction(3, 4) * (n - m) * m * m)
+
+
+def exact(values) -> list:
+    return [Fraction(float(v)) for v in values]
+
+
+RNG = np.random.default_rng(20261125)
+SMALL_X = np.cumsum(RNG.standard_normal(40))
+SMALL_Y = RNG.standard_normal(40)
+
+
+@pytest.mark.parametrize("m", [1, 2, 3, 5, 13])
+def test_mtotdev_equals_exact_formula(m):
+    res = avar.mtotdev(SMALL_X, data_type="phase", taus=[float(m)])
+    assert res.n.tolist() == [40 - 3 * m + 1]
+    assert res.variance[0] == pytest.approx(float(plain_mtotvar(exact(SMALL_X), m)), rel=1e-11)
+    t = avar.ttotdev(SMALL_X, rate=4.0, data_type="phase", taus=[m / 4.0])
+    assert t.variance[0] == pytest.approx(float(plain_mtotvar(exact(SMALL_X), m)) * 16 * (m / 4.0) ** 2 / 3, rel=1e-11)
+
+
+@pytest.mark.parametrize("m", [2, 3, 6, 13])
+def test_htotdev_equals_exact_formula(m):
+    res = avar.htotdev(SMALL_Y, taus=[float(m)], bias_correction=False)
+    assert res.n.tolist() == [40 - 3 * m + 1]
+    assert res.variance[0] == pytest.approx(float(plain_htotvar(exact(SMALL_Y), m)), rel=1e-11)
+
+
+def test_htotdev_is_ohdev_at_one_and_blind_to_drift():
+    drifting = SMALL_Y + 0.3 * np.arange(40) + 5.0
+    res = avar.htotdev(drifting, taus="all", bias_correction=False)
+    assert res.deviation[0] == pytest.approx(avar.ohdev(SMALL_Y, taus=[1.0]).deviation[0], rel=1e-12)
+    base = avar.htotdev(SMALL_Y, taus="all", bias_correction=False)
+    np.testing.assert_allclose(res.deviation, base.deviation, rtol=1e-9)
+
+
+@pytest.mark.parametrize("m", [2, 4, 10, 38])
+def test_theo1_equals_exact_formula(m):
+    res = avar.theo1(SMALL_X, rate=2.0, data_type="phase", taus=[0.75 * m / 2.0])
+    assert res.taus.tolist() == [0.375 * m] and res.n.tolist() == [(40 - m) * m // 2]
+    assert res.variance[0] == pytest.approx(float(plain_theo1(exact(SMALL_X), m)) * 4.0, rel=1e-11)
+
+
+def test_kernels_match_the_plain_loops_on_larger_data():
+    x = np.cumsum(RNG.standard_normal(60))
+    for m in (1, 4, 19):
+        total, count = mtot_sum(x, m, NO_GAPS, 0)
+        assert count == 60 - 3 * m + 1
+        assert total / (2 * m * m * count) == pytest.approx(float(plain_mtotvar(exact(x), m)), rel=1e-10)
+    y = np.diff(x)
+    total, count = htot_sum(x, 6, NO_GAPS, 0)
+    assert total / (6 * count) == pytest.approx(float(plain_htotvar(exact(y), 6)), rel=1e-10)
+
+
+def test_theo1_all_factors_at_once_equals_the_direct_sum():
+    for x in (RNG.standard_normal(121), np.cumsum(RNG.standard_normal(121)), np.cumsum(np.cumsum(RNG.standard_normal(121)))):
+        x = x - np.polyval(np.polyfit(np.arange(121), x, 1), np.arange(121))
+        fast = theo1_all(x, 60, np.zeros(0))
+        direct = np.array([theo1_sum(x, 2 * k, NO_GAPS, 0)[0] for k in range(1, 61)])
+        np.testing.assert_allclose(fast, direct, rtol=1e-9)
+        looked_up = theo1_all(x, 60, autocorrelation(x))
+        assert np.all(np.abs(looked_up / direct - 1) < 1e-15 * theo1_ratio(x, looked_up) * 60)
+        m = np.arange(1, 60)
+        sums, ratio = oavar_expanded(x, m, autocorrelation(x))
+        assert np.all(np.abs(sums / oavar_sums(x, m) - 1) < 1e-15 * ratio * 60)
+
+
+@pytest.mark.parametrize("name", ["mtotdev", "ttotdev", "htotdev", "theo1"])
+@pytest.mark.parametrize("data_type", ["phase", "freq"])
+def test_equal_to_allantools(name, data_type):
+    data = np.cumsum(RNG.standard_normal(160)) if data_type == "phase" else RNG.standard_normal(160)
+    ours = getattr(avar, name)(data, rate=10.0, data_type=data_type, taus="octave", bias_correction=False)
+    taus = ours.averaging_factors / 10.0
+    theirs = getattr(allantools, name)(data, rate=10.0, data_type=data_type, taus=taus)
+    k = len(theirs[1])  # allantools drops single-term levels
+    assert k >= len(ours) - 1
+    first = 1 if name == "htotdev" else 0  # allantools' HTOTDEV at m = 1 is OHDEV too, but from phase rounding
+    np.testing.assert_allclose(ours.deviation[first:k], theirs[1][first:k], rtol=1e-10)
+    if name == "theo1":
+        np.testing.assert_allclose(theirs[0] * 0.75, ours.taus[:k])  # allantools labels Theo1 at m tau0
+    assert ours.n[:k].tolist() == theirs[3].astype(int).tolist()
+
+
+def test_large_offset_and_frequency_do_not_cost_accuracy():
+    x = np.cumsum(RNG.standard_normal(200)) * 1e-9
+    shifted = x + 1.0 + 1e-6 * np.arange(200)  # 1 s offset and a 1e-6 frequency offset, 1e9 x the noise
+    for name in ("mtotdev", "htotdev", "theo1"):
+        a = getattr(avar, name)(x, data_type="phase", bias_correction=False)
+        b = getattr(avar, name)(shifted, data_type="phase", bias_correction=False)
+        np.testing.assert_allclose(b.deviation, a.deviation, rtol=1e-5)  # the input itself is exact to ~1e-7 of the noise
+
+
+def test_white_fm_theory():
+    """White FM: MTOTVAR ~ MVAR = sigma^2 / (2 tau) (large m), Theo1 and HTOTVAR unbiased, ThêoH ~ AVAR."""
+    y = np.random.default_rng(7).standard_normal(2**14)
+    h = avar.htotdev(y, taus=[64.0])
+    assert h.deviation[0] == pytest.approx(np.sqrt(1 / 64), rel=0.1)
+    t = avar.theo1(y, taus=[0.75 * 256])
+    assert t.deviation[0] == pytest.approx(np.sqrt(1 / 192), rel=0.1)
+    th = avar.theoh(y)
+    assert np.all(np.abs(th.deviation / np.sqrt(1 / th.taus) - 1)[:-1] < 0.25)  # the last level: 2 terms
+    assert th.alpha[:8].tolist() == [0] * 8
+
+
+def test_theobr_factor_follows_its_definition():
+    x = np.cumsum(np.random.default_rng(3).standard_normal(400))
+    kf, n = theobr_factor(x)
+    assert n == 400 // 30 - 3
+    ratios = []
+    for i in range(n + 1):
+        ma, mt = 9 + 3 * i, 12 + 4 * i
+        avar_i = oavar_sums(x, np.array([ma]))[0] / (2 * ma * ma * (400 - 2 * ma))
+        theo_i = theo1_sum(x, mt, NO_GAPS, 0)[0] / (0.75 * (400 - mt) * mt * mt)
+        ratios.append(avar_i / theo_i)
+    assert kf == pytest.approx(np.mean(ratios), rel=1e-10)
+    res = avar.theoh(x, data_type="phase", taus=[2.0, 150.0])
+    assert res.averaging_factors.tolist() == [2, 200]
+    assert res.deviation[0] == pytest.approx(avar.oadev(x, data_type="phase", taus=[2.0]).deviation[0], rel=1e-12)
+    raw = avar.theo1(x, data_type="phase", taus=[150.0], bias_correction=False).variance[0]
+    assert res.variance[1] == pytest.approx(kf * raw, rel=1e-12)
+
+
+def test_edf_and_bias_formulas():
+    np.testing.assert_allclose(total_edf("mtotdev", np.array([2, 1, 0, -1, -2]), np.full(5, 10), 1001),
+                               [1.9 * 100.1 - 2.1, 1.2 * 100.1 - 1.4, 1.1 * 100.1 - 1.2, 0.85 * 100.1 - 0.5,
+                                0.75 * 100.1 - 0.31])
+    r, n = 75.0, 1001.0
+    assert total_edf("theo1", np.array([0]), np.array([100]), 1001)[0] == pytest.approx(
+        ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * r**1.5 / (r**1.5 + 5.2))
+    assert total_edf("htotdev", np.array([-1]), np.array([32]), 1001)[0] == pytest.approx((n / 32) / (0.868 + 1.14 * 32 / n))
+    assert total_edf("htotdev", np.array([-1]), np.array([8]), 1001)[0] == pytest.approx(
+        estimator_edf("ohdev", [-1], [8], 1001)[0])
+    y = np.random.default_rng(5).standard_normal(500)
+    raw = avar.htotdev(y, taus=[4.0], alpha=-1, bias_correction=False)
+    fixed = avar.htotdev(y, taus=[4.0], alpha=-1)
+    assert fixed.variance[0] == pytest.approx(raw.variance[0] / 0.851)
+    t_raw = avar.theo1(y, taus=[7.5], alpha=2)
+    t_fix = avar.theo1(y, taus=[7.5], alpha=2, bias_correction=True)
+    assert t_fix.variance[0] == pytest.approx(t_raw.variance[0] * (0.09 + 0.74 / 7.5**0.4))
+    assert t_fix.alpha.tolist() == [2] and t_fix.edf[0] == pytest.approx(
+        0.86 * 502 * (501 - 10) / (501 - 7.5) * 7.5 / 8.64)  # N = 501 phase points
+
+
+def test_gaps_skip_the_windows_that_touch_them():
+    x = np.cumsum(RNG.standard_normal(60))
+    holed = x.copy()
+    holed[30] = np.nan
+    res = avar.mtotdev(holed, data_type="phase", taus=[2.0], nan_policy="omit")
+    windows = [i for i in range(60 - 5) if not 24 < i <= 30]
+    expected = sum(reflected_total(exact(x[i : i + 6]), 2) for i in windows) / (2 * 4 * len(windows))
+    assert res.n.tolist() == [len(windows)] and res.variance[0] == pytest.approx(float(expected), rel=1e-10)
+    th = avar.theo1(holed, data_type="phase", taus=[3.0], nan_policy="omit")
+    assert th.n.tolist() == [2 * len([i for i in range(56) if not 26 <= i <= 30])]
+    with pytest.raises(ValueError, match="NaN"):
+        avar.theoh(np.concatenate((x, holed)), data_type="phase", nan_policy="omit")
+
+
+def test_grids_and_validation():
+    assert total_factors("theo1", 100, 1.0, "octave").tolist() == [2, 4, 8, 16, 32, 64]
+    assert total_factors("theo1", 100, 1.0, "decade").tolist() == [2, 4, 10, 20, 40]
+    assert total_factors("mtotdev", 100, 1.0, "octave").tolist() == [1, 2, 4, 8, 16, 32]
+    with pytest.raises(ValueError, match="m even"):
+        avar.theo1(SMALL_Y, taus=[2.25])
+    with pytest.raises(ValueError, match="alpha must be in -2 .. 2"):
+        avar.mtotdev(SMALL_Y, alpha=3)
+    with pytest.raises(TypeError, match="alpha must be None or an integer"):
+        avar.htotdev(SMALL_Y, alpha=0.5)
+    with pytest.raises(TypeError, match="bias_correction"):
+        avar.theo1(SMALL_Y, bias_correction="yes")
+    with pytest.raises(ValueError, match="at least 90 phase points"):
+        avar.theoh(SMALL_Y)
+    with pytest.raises(ValueError, match="switch"):
+        avar.theoh(np.zeros(200), switch=0.9)
+    with pytest.raises(ValueError, match="data_type"):
+        avar.ttotdev(SMALL_Y, data_type="time")
+    res = avar.ttotdev(SMALL_Y, rate=2.0, alpha=-1)
+    assert res.estimator == "ttotdev" and set(res.alpha.tolist()) == {-1}
+    assert "time total deviation" in str(res) and len(res.summary()) == len(res)
+
+
+# Stable32 on its PHASE.DAT (N = 1001 phase points), confidence 0.683: AF, #, alpha, min, sigma, max.
+STABLE32_HTOTDEV = [(16, 953, 0, 6.1280e-02, 6.5265e-02, 7.0151e-02), (32, 905, 0, 4.0870e-02, 4.4644e-02, 4.9703e-02),
+                    (64, 809, 0, 2.9694e-02, 3.3576e-02, 3.9530e-02)]
+STABLE32_COUNTS = {"mtotdev": {1: 999, 2: 996, 16: 954, 256: 234}, "htotdev": {1: 998, 2: 995, 128: 617, 256: 233},
+                   "theo1": {10: 4955, 100: 45050, 998: 1497}}  # Thêo1 #, printed 4.9550e+03 ...
+
+
+def test_stable32_htotdev_bounds_and_term_counts():
+    from avar.stability.edf import chi2_bounds
+    from avar.stability.total_edf import term_counts
+
+    rows = np.array(STABLE32_HTOTDEV)
+    edf = total_edf("htotdev", rows[:, 2].astype(int), rows[:, 0].astype(int), 1001)
+    lci, uci = chi2_bounds(rows[:, 4], edf, 0.683)
+    np.testing.assert_allclose(lci, rows[:, 3], rtol=1e-3)  # Stable32 prints 5 digits
+    np.testing.assert_allclose(uci, rows[:, 5], rtol=1e-3)
+    for name, counts in STABLE32_COUNTS.items():
+        assert term_counts(name, 1001, np.array(list(counts))).tolist() == list(counts.values())
+    # Stable32's HTOTDEV of PHASE.DAT with and without its bias removal at m = 2 (alpha = 0):
+    assert (2.0297e-01 / 2.0247e-01) ** 2 == pytest.approx(1 / 0.995, rel=5e-4)
+
+
+def test_theo1_by_fft_equals_the_direct_sum(monkeypatch):
+    from avar._kernels import theo_fft
+
+    rng = np.random.default_rng(11)
+    for x in (rng.standard_normal(3001), np.cumsum(rng.standard_normal(3001)),
+              np.cumsum(np.cumsum(rng.standard_normal(3001)))):
+        x = x - np.polyval(np.polyfit(np.arange(3001), x, 1), np.arange(3001))
+        prepared = (np.concatenate(([0.0], np.cumsum(x * x))), theo_fft.autocorrelation(x),
+                    np.ascontiguousarray(x[::-1]))
+        for m in (2, 300, 1026, 3000):
+            total, ratio = theo_fft.theo1_expanded(x, m, *prepared)
+            direct = theo1_sum(x, m, NO_GAPS, 0)[0]
+            assert total == pytest.approx(direct, rel=max(1e-13, 1e-14 * ratio)), (m, ratio)
+    triangle = theo_fft.triangle_sum(x, 3, 5, 700, np.arange(-800.0, 801.0), 800)
+    assert triangle == pytest.approx(sum((5 + q - 3 - p) * x[3 + p] * x[5 + q] for p in range(700)
+                                         for q in range(700 - p)), rel=1e-11)
+    monkeypatch.setattr(theo_fft, "DIRECT_TERMS", 0)  # every level by FFT, or direct where ill-conditioned
+    factors = np.array([2, 4, 64, 512, 2048])
+    sums, expanded = theo_fft.theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, NO_GAPS, 0)[0])
+    assert 0 < expanded < factors.size  # the random-walk-FM phase keeps its small levels direct
+    np.testing.assert_allclose(sums, [theo1_sum(x, m, NO_GAPS, 0)[0] for m in factors], rtol=1e-10)
+    y = rng.standard_normal(2000)
+    slow = avar.theo1(y)
+    monkeypatch.setattr(theo_fft, "DIRECT_TERMS", 0)
+    np.testing.assert_allclose(avar.theo1(y).deviation, slow.deviation, rtol=1e-10)
