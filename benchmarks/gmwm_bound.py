@@ -30,7 +30,7 @@ usable here: its O(1 / n) leakage from the differenced white noise (about
 2 sigma2 / n) exceeds gamma2 at the few frequencies where the random walk lives.
 
 Also printed, all asymptotic at the truth from the exact covariance Sigma of
-the maximal-overlap AV estimates (:mod:`avar.fit.gmwm_covariance`), J = d nu / d theta:
+the maximal-overlap AV estimates (:mod:`avar.fit.gmwm.covariance`), J = d nu / d theta:
 
 * ``gmwm diag (pred)``: the sandwich (J'WJ)^-1 J'W Sigma W J (J'WJ)^-1 of the
   default weights W = diag(edf_j / (2 nu_j^2)) on the octave grid;
@@ -67,7 +67,7 @@ from gmwm_vs_avlr import AVLR_PARAMETERS, SCENARIOS, N
 
 import avar
 from avar.fit.gmwm import octave_factors
-from avar.fit.gmwm_covariance import mo_av_covariance
+from avar.fit.gmwm.covariance import mo_av_covariance
 from avar.models import AR1, DR, QN, RW, WN
 
 
@@ -132,7 +132,7 @@ def crb(model, n_samples: int) -> pd.DataFrame:
 def av_jacobian(model, factors: np.ndarray) -> np.ndarray:
     """d nu / d theta (central differences of the closed forms), shape (scales, parameters)."""
     theta = model.parameter_vector
-    spec = avar.fit.gmwm_model.parse_model(model)
+    spec = avar.fit.gmwm.model.parse_model(model)
     out = np.empty((factors.size, theta.size))
     for i in range(theta.size):
         step = 1e-6 * abs(theta[i])
@@ -179,7 +179,7 @@ def whittle_mle(x: np.ndarray, truth) -> np.ndarray:
     f = frequencies(n)
     coefficients = dst(d, type=1, norm="ortho")
     loadings = mean_loadings(n)
-    spec = avar.fit.gmwm_model.parse_model(truth)
+    spec = avar.fit.gmwm.model.parse_model(truth)
     labels = truth.parameter_names
     has_mean = "DR.omega" in labels
     cov_index = [i for i, name in enumerate(labels) if name != "DR.omega"]

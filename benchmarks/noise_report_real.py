@@ -164,7 +164,7 @@ def row_of_channel(report, channel: str, process: str) -> dict:
 
 
 def to_si(report, channel: str, value: float) -> float:
-    from avar.fit.noise_terms import to_si as convert
+    from avar.fit.report.noise_terms import to_si as convert
 
     k = report.channels.index(channel)
     return convert(value, report.sensor_types[k], report.units[k])

@@ -11,7 +11,7 @@ import pytest
 
 import avar
 from avar.fit.gmwm import gmwm, octave_factors
-from avar.fit.gmwm_results import GmwmResult, ImuGmwmResult
+from avar.fit.gmwm.results import GmwmResult, ImuGmwmResult
 from avar.imu import IMU
 from avar.models import AR1, DR, QN, RW, WN, Process
 from avar.stability.results import AllanVariance

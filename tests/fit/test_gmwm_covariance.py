@@ -1,4 +1,4 @@
-"""Tests of avar.fit.gmwm_covariance and weights='efficient' of avar.gmwm."""
+"""Tests of avar.fit.gmwm.covariance and weights='efficient' of avar.gmwm."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from avar.fit.gmwm import gmwm, octave_factors
-from avar.fit.gmwm_covariance import increment_autocovariance, mo_av_covariance
+from avar.fit.gmwm.covariance import increment_autocovariance, mo_av_covariance
 from avar.models import AR1, DR, FN, QN, RW, WN
 from avar.stability.results import AllanVariance
 

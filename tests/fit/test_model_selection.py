@@ -7,7 +7,7 @@ import pytest
 
 import avar
 from avar.fit.gmwm import gmwm
-from avar.fit.model_selection import select_model
+from avar.fit.gmwm.selection import select_model
 from avar.models import RW, WN
 
 

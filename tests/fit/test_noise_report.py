@@ -11,7 +11,7 @@ import pytest
 
 import avar
 from avar.fit.noise_fit import FLICKER_FACTOR, fit_noise_terms, term_regressors
-from avar.fit.sensor_terms import FLICKER_AV_FACTOR
+from avar.fit.report.sensor_terms import FLICKER_AV_FACTOR
 from avar.models import FN, QN, RW, WN
 
 FREQ = 100.0

@@ -14,10 +14,10 @@ import pytest
 
 import avar
 from avar.fit.gmwm import octave_factors
-from avar.fit.gmwm_covariance import mo_av_covariance
-from avar.fit.report_checks import data_warnings, fit_check, unit_warnings
-from avar.fit.sensor_fit import fit_sensor_model, term_bound
-from avar.fit.sensor_terms import OCTAVE_CORRELATION, basis, flicker_unit_av, level_correlation
+from avar.fit.gmwm.covariance import mo_av_covariance
+from avar.fit.report.checks import data_warnings, fit_check, unit_warnings
+from avar.fit.report.sensor_fit import fit_sensor_model, term_bound
+from avar.fit.report.sensor_terms import OCTAVE_CORRELATION, basis, flicker_unit_av, level_correlation
 from avar.models import AR1, QN, RW, SIN, WN
 from avar.models.flicker import av_fn
 

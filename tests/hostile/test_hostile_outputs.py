@@ -222,7 +222,7 @@ def test_bad_option_values_are_usage_errors(args, fragment, data_file, capsys):
 
 
 def test_kalibr_with_a_failing_plot_writes_nothing(tmp_path, capsys, monkeypatch):
-    from avar.fit import report_result
+    from avar.fit.report import result as report_result
 
     data_file = tmp_path.parent / f"{tmp_path.name}-gyro.csv"
     gx = (avar.WN(sigma2=1e-6) + avar.RW(gamma2=1e-10)).simulate(100_000, seed=7)
@@ -247,7 +247,7 @@ def _report(source=None):
 
 
 def test_write_kalibr_mode_follows_the_umask(tmp_path):
-    from avar.fit.kalibr import write_kalibr
+    from avar.fit.report.kalibr import write_kalibr
 
     old = os.umask(0o027)
     try:
@@ -260,7 +260,7 @@ def test_write_kalibr_mode_follows_the_umask(tmp_path):
 
 
 def test_write_kalibr_refuses_nan_fifos_and_names_the_target(tmp_path):
-    from avar.fit.kalibr import write_kalibr
+    from avar.fit.report.kalibr import write_kalibr
 
     with pytest.raises(ValueError, match=r"\['gyroscope_noise_density'\] are not finite numbers"):
         write_kalibr(_report(), tmp_path / "a.yaml", gyroscope_noise_density=float("nan"))

@@ -48,7 +48,7 @@ def read_recording(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    from avar.fit.noise_report import noise_report
+    from avar.fit.report.noise_report import noise_report
 
     inputs = [Path(args.file)]
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)

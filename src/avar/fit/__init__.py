@@ -6,13 +6,10 @@
 * :mod:`avar.fit.results`: :class:`AvlrResult`, :class:`ImuAvlrResult`;
 * :mod:`avar.fit.noise_fit`: the joint weighted fit of the IEEE 952 terms;
 * :mod:`avar.fit.auto_scales`: where each process dominates (:func:`auto_scales`);
-* :mod:`avar.fit.noise_terms`: IEEE 952 term names, SI and customary units;
-* :mod:`avar.fit.noise_report`: :func:`noise_report`, whose result is
-  :class:`~avar.fit.report_result.NoiseReport`; :mod:`avar.fit.kalibr`: Kalibr ``imu.yaml``.
-* :mod:`avar.fit.gmwm`: :func:`gmwm`, the joint estimator (GMWM), with its model
-  (``gmwm_model``), implied AV (``gmwm_implied``), objective (``gmwm_objective``),
-  bootstraps (``gmwm_bootstrap``) and results (``gmwm_results``);
-* :mod:`avar.fit.model_selection`: :func:`select_model`.
+* :mod:`avar.fit.report`: the IMU noise report, :func:`noise_report` (the noise model a real
+  sensor's data support, its check, the terms in SI and customary units, warnings, Kalibr);
+* :mod:`avar.fit.gmwm`: :func:`gmwm`, the joint estimator (GMWM): its model, implied AV,
+  objective, covariance, bootstraps, results and model selection (:func:`select_model`).
 """
 
 from avar.fit.avlr import avlr

@@ -55,7 +55,7 @@ def plot_gmwm(
     >>> [line.get_label() for line in fit.plot().axes[0].lines]
     ['Empirical AD', 'Implied AD', 'WN', 'RW']
     """
-    from avar.fit.gmwm_results import GmwmResult
+    from avar.fit.gmwm.results import GmwmResult
 
     if not isinstance(x, GmwmResult):
         raise TypeError(f"x must be a GmwmResult (from avar.gmwm), got {type(x).__name__}")
@@ -88,7 +88,7 @@ def plot_imu_gmwm(x: Any, decomp: bool = True, deviation: bool = True, **kwargs:
     >>> len(fit.plot().axes)
     2
     """
-    from avar.fit.gmwm_results import ImuGmwmResult
+    from avar.fit.gmwm.results import ImuGmwmResult
 
     if not isinstance(x, ImuGmwmResult):
         raise TypeError(f"x must be an ImuGmwmResult (from avar.gmwm on IMU data), got {type(x).__name__}")

@@ -107,7 +107,7 @@ def plot_report(
     >>> [line.get_label() for line in fig.axes[0].lines][1:]
     ['N = 0.342 deg/sqrt(h)', 'B = 6.38 deg/h (IEEE 952: AD = 0.664 B)', 'AD minimum 2.51 deg/h at 164 s', 'Implied AD (sum of variances)']
     """
-    from avar.fit.report_result import NoiseReport
+    from avar.fit.report.result import NoiseReport
 
     if not isinstance(report, NoiseReport):
         raise TypeError(f"report must be a NoiseReport (from avar.noise_report), got {type(report).__name__}")
@@ -143,7 +143,7 @@ def plot_report(
 
 def _customary_axis(ax: Any, report: Any, channel: str) -> None:
     """A right axis in deg/h or ug for a gyroscope or accelerometer in known units."""
-    from avar.fit.noise_terms import ACCEL, GYRO, to_si
+    from avar.fit.report.noise_terms import ACCEL, GYRO, to_si
 
     index = report.channels.index(channel)
     kind, unit = report.sensor_types[index], report.units[index]

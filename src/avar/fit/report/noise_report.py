@@ -4,10 +4,10 @@ One call, no scales to pick: for every channel, the maximal-overlap Allan
 variance on octaves from m = 1, its chi-squared band (Greenhall's EDF at the
 fitted noise type), the noise model chosen by the data among sums of QN,
 WN, FN, RW, DR, up to two Gauss-Markov and two sinusoid terms
-(:mod:`avar.fit.sensor_fit`), the terms in SI and customary units with
-intervals (:mod:`avar.fit.report_rows`), the Allan-deviation minimum, and
-checks of the fit, the units and the data (:mod:`avar.fit.report_checks`).
-The result is a :class:`~avar.fit.report_result.NoiseReport`.
+(:mod:`avar.fit.report.sensor_fit`), the terms in SI and customary units with
+intervals (:mod:`avar.fit.report.rows`), the Allan-deviation minimum, and
+checks of the fit, the units and the data (:mod:`avar.fit.report.checks`).
+The result is a :class:`~avar.fit.report.result.NoiseReport`.
 """
 
 from __future__ import annotations
@@ -20,11 +20,11 @@ import pandas as pd
 
 from avar._validation import as_series, check_real
 from avar.fit.gmwm import octave_factors
-from avar.fit.noise_terms import ACCEL, GYRO, check_unit
-from avar.fit.report_checks import FIT_SHARE, data_warnings, fit_check, unit_warnings
-from avar.fit.report_result import NoiseReport
-from avar.fit.report_rows import channel_rows, minimum_row
-from avar.fit.sensor_fit import SensorFit, fit_sensor_model, with_sampling_edf
+from avar.fit.report.checks import FIT_SHARE, data_warnings, fit_check, unit_warnings
+from avar.fit.report.noise_terms import ACCEL, GYRO, check_unit
+from avar.fit.report.result import NoiseReport
+from avar.fit.report.rows import channel_rows, minimum_row
+from avar.fit.report.sensor_fit import SensorFit, fit_sensor_model, with_sampling_edf
 from avar.imu import IMU
 from avar.stability.allan import avar as allan_variance
 from avar.stability.results import AllanVariance, ImuAllanVariance
@@ -135,7 +135,7 @@ def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray,
     slope (alpha = -1 - d log AV / d log tau, rounded into -2..2). When the
     selected model fits fewer than 90 % of the levels, the selection is
     extended by the terms the data demand (``check`` of
-    :func:`~avar.fit.sensor_fit.fit_sensor_model`).
+    :func:`~avar.fit.report.sensor_fit.fit_sensor_model`).
     """
     factors = np.asarray(av.averaging_factors, dtype=np.int64)
     counts = np.maximum(av.n - 2 * factors + 1, 1)
@@ -187,7 +187,7 @@ def noise_report(
     WN, flicker FN, random walk RW, ramp DR, up to two first-order
     Gauss-Markov and two sinusoid terms, fitted jointly at every level by
     maximum likelihood and selected by a penalized deviance
-    (:func:`avar.fit.sensor_fit.fit_sensor_model`); then, in SI and customary
+    (:func:`avar.fit.report.sensor_fit.fit_sensor_model`); then, in SI and customary
     units with 1 - alpha intervals:
 
     * quantization Q, angle / velocity random walk N, bias instability B

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from avar.fit.gmwm_model import ModelSpec
+from avar.fit.gmwm.model import ModelSpec
 
 __all__ = ["ImpliedAllanVariance"]
 

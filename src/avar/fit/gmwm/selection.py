@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar.fit.gmwm import empirical_allan_variance, fit_allan_variance
-from avar.fit.gmwm_model import parse_model
-from avar.fit.gmwm_objective import equivalent_dof, fit_av
+from avar.fit.gmwm.estimator import empirical_allan_variance, fit_allan_variance
+from avar.fit.gmwm.model import parse_model
+from avar.fit.gmwm.objective import equivalent_dof, fit_av
 
 __all__ = ["select_model"]
 
@@ -21,7 +21,7 @@ def select_model(x: Any, candidates: Sequence[Any], *, taus: Any = "octave", pen
     Every candidate is fitted by :func:`avar.gmwm` (diagonal weights), then
     refitted from there with one weight matrix shared by all candidates, the
     data's: W = diag(1 / s_j^2), s_j = nu_hat_j sqrt(2 / edf_j), the estimated
-    standard deviation of nu_hat_j (edf_j as in :mod:`avar.fit.gmwm_objective`).
+    standard deviation of nu_hat_j (edf_j as in :mod:`avar.fit.gmwm.objective`).
     With a common W the objectives are comparable (a candidate's own weights
     would favour a model that predicts large variances where it fits badly,
     and a model nested in another can never reach a lower minimum). The

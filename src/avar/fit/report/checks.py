@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from avar.fit.noise_terms import ACCEL, GYRO, GYRO_UNITS
+from avar.fit.report.noise_terms import ACCEL, GYRO, GYRO_UNITS
 
 __all__ = ["fit_check", "unit_warnings", "data_warnings", "FIT_TOLERANCE", "FIT_SHARE", "OUTLIER_MAD"]
 

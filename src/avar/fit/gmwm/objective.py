@@ -8,7 +8,7 @@ generalized method of wavelet moments (Guerrier et al. 2013) with weight 4 W.
 
 It runs in two steps, each a Levenberg-Marquardt least-squares fit
 (``scipy.optimize.least_squares``) over the unconstrained parameters of
-:class:`~avar.fit.gmwm_model.ModelSpec`:
+:class:`~avar.fit.gmwm.model.ModelSpec`:
 
 1. log scale: minimize sum_j (edf_j / 2) (log nu_hat_j - log nu_j(theta))^2,
    from a few starting points (below), keeping the best. ``2 / edf_j``
@@ -21,9 +21,9 @@ It runs in two steps, each a Levenberg-Marquardt least-squares fit
    residuals on the linear scale, where nu_hat is unbiased, so the log bias
    -1 / edf_j of step 1 does not reach the estimates). ``"full"``: W the
    inverse of a covariance matrix of nu_hat (from a short parametric
-   bootstrap at theta_1, see :mod:`avar.fit.gmwm_bootstrap`); ``"efficient"``:
+   bootstrap at theta_1, see :mod:`avar.fit.gmwm.bootstrap`); ``"efficient"``:
    W the inverse of the exact Gaussian covariance of nu_hat at theta_1
-   (:mod:`avar.fit.gmwm_covariance`), the optimal GMM weight.
+   (:mod:`avar.fit.gmwm.covariance`), the optimal GMM weight.
    ``"identity"``: step 1 alone, with edf_j = 2 (unweighted log scale).
 
 Starting values: each process whose values are not given starts on the
@@ -44,8 +44,8 @@ from typing import Any
 
 import numpy as np
 
-from avar.fit.gmwm_implied import ImpliedAllanVariance
-from avar.fit.gmwm_model import ModelSpec, transform_of
+from avar.fit.gmwm.implied import ImpliedAllanVariance
+from avar.fit.gmwm.model import ModelSpec, transform_of
 
 __all__ = ["equivalent_dof", "implied_av", "starting_points", "fit_av", "GmwmFit"]
 

@@ -1,6 +1,6 @@
 """The rows of a noise report: every fitted term of one channel in SI and customary units.
 
-From a :class:`~avar.fit.sensor_fit.SensorFit` (per-sample variances) to
+From a :class:`~avar.fit.report.sensor_fit.SensorFit` (per-sample variances) to
 the continuous-time coefficients an engineer compares with a datasheet, at
 a sampling rate f (Hz), in data units u:
 
@@ -31,8 +31,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar.fit.noise_terms import ACCEL, GYRO, TERM_NAMES, customary, to_si, unit_of
-from avar.fit.sensor_fit import SensorFit, term_bound
+from avar.fit.report.noise_terms import ACCEL, GYRO, TERM_NAMES, customary, to_si, unit_of
+from avar.fit.report.sensor_fit import SensorFit, term_bound
 
 __all__ = ["channel_rows", "minimum_row", "BOUNDED", "ROW_COLUMNS"]
 

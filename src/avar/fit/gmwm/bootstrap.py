@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 
 from avar.fit.bootstrap import replicate_allan_variances
-from avar.fit.gmwm_model import ModelSpec
-from avar.fit.gmwm_objective import GmwmFit, fit_av
+from avar.fit.gmwm.model import ModelSpec
+from avar.fit.gmwm.objective import GmwmFit, fit_av
 
 __all__ = ["av_covariance", "bootstrap_fits", "interval_table"]
 

@@ -1,4 +1,4 @@
-"""Kalibr ``imu.yaml`` from a :class:`~avar.fit.report_result.NoiseReport`.
+"""Kalibr ``imu.yaml`` from a :class:`~avar.fit.report.result.NoiseReport`.
 
 Kalibr (and ``allan_variance_ros``) describe an IMU by four continuous-time
 densities in SI units, each aggregated over the axes of a sensor type:
@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from avar.fit.noise_terms import ACCEL, GYRO
+from avar.fit.report.noise_terms import ACCEL, GYRO
 
 __all__ = ["kalibr_fields", "kalibr_notes", "kalibr_text", "write_kalibr", "axis_values", "nominal_rate",
            "DEFAULT_TOPIC"]

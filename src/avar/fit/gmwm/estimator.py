@@ -1,9 +1,9 @@
 """The joint estimator: :func:`gmwm`, a sum of processes fitted at all scales at once.
 
-The model is parsed in :mod:`avar.fit.gmwm_model`, its Allan variance and
-Jacobian come from :mod:`avar.fit.gmwm_implied`, the weights and the
-optimizer from :mod:`avar.fit.gmwm_objective`, the bootstraps from
-:mod:`avar.fit.gmwm_bootstrap`; the results are in :mod:`avar.fit.gmwm_results`.
+The model is parsed in :mod:`avar.fit.gmwm.model`, its Allan variance and
+Jacobian come from :mod:`avar.fit.gmwm.implied`, the weights and the
+optimizer from :mod:`avar.fit.gmwm.objective`, the bootstraps from
+:mod:`avar.fit.gmwm.bootstrap`; the results are in :mod:`avar.fit.gmwm.results`.
 """
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ import numpy as np
 import pandas as pd
 
 from avar._validation import as_series, check_real, check_replicates, check_seed
-from avar.fit.gmwm_model import ModelSpec, parse_model
-from avar.fit.gmwm_objective import WEIGHTINGS, equivalent_dof, fit_av
-from avar.fit.gmwm_results import GmwmResult, ImuGmwmResult
+from avar.fit.gmwm.model import ModelSpec, parse_model
+from avar.fit.gmwm.objective import WEIGHTINGS, equivalent_dof, fit_av
+from avar.fit.gmwm.results import GmwmResult, ImuGmwmResult
 from avar.imu import ACCELEROMETER, GYROSCOPE, IMU
 from avar.recording import Recording
 from avar.stability.allan import avar as allan_variance
@@ -61,7 +61,7 @@ def gmwm(
         The processes to fit: ``"WN + RW + AR1"``, ``[avar.WN, avar.AR1]``, or
         instances whose values start the optimizer (``avar.WN(sigma2=1) +
         avar.RW(gamma2=1e-6)``). Any ``Process`` subclass (flicker noise
-        included) works; see :mod:`avar.fit.gmwm_model` for the constraints
+        included) works; see :mod:`avar.fit.gmwm.model` for the constraints
         (variances > 0 by a log, |phi| < 1 by atanh). Repeated AR1 terms are
         ordered by phi (correlation time).
     taus : "octave" or as in :func:`avar.avar`
@@ -78,13 +78,13 @@ def gmwm(
         simulating 200 series. ``"efficient"``: W the inverse of the exact
         Gaussian covariance of nu_hat at theta_1, computed from the
         autocovariance of the first differences
-        (:mod:`avar.fit.gmwm_covariance`; "mo" AV of WN, QN, RW, DR and AR1
+        (:mod:`avar.fit.gmwm.covariance`; "mo" AV of WN, QN, RW, DR and AR1
         only): the asymptotically optimal weighting, without simulation.
         ``"identity"``: unweighted on the log scale.
     ci : bool
         Parametric bootstrap: simulate the fitted model ``B`` times at the same
         N, refit each, report standard errors and intervals (see
-        :func:`avar.fit.gmwm_bootstrap.interval_table`).
+        :func:`avar.fit.gmwm.bootstrap.interval_table`).
     B : int
         Bootstrap replicates (>= 2).
     alpha : float
@@ -98,7 +98,7 @@ def gmwm(
     Returns
     -------
     GmwmResult
-        Or :class:`~avar.fit.gmwm_results.ImuGmwmResult` for IMU data.
+        Or :class:`~avar.fit.gmwm.results.ImuGmwmResult` for IMU data.
 
     References
     ----------
@@ -177,14 +177,14 @@ def fit_allan_variance(
     rng = np.random.default_rng(seed)
     covariance = None
     if weights == "efficient":
-        from avar.fit.gmwm_covariance import check_supported, mo_av_covariance
+        from avar.fit.gmwm.covariance import check_supported, mo_av_covariance
 
         check_supported(spec.classes, av.type)
 
         def covariance(theta: np.ndarray) -> np.ndarray:
             return mo_av_covariance(spec.model(theta), av.n, factors)
     elif weights == "full":
-        from avar.fit.gmwm_bootstrap import av_covariance
+        from avar.fit.gmwm.bootstrap import av_covariance
 
         def covariance(theta: np.ndarray) -> np.ndarray:
             return av_covariance(spec, theta, av.n, factors, av.type, FULL_REPLICATES, rng)
@@ -193,7 +193,7 @@ def fit_allan_variance(
     model = spec.model(fit.theta)
     table = None
     if ci:
-        from avar.fit.gmwm_bootstrap import bootstrap_fits, interval_table
+        from avar.fit.gmwm.bootstrap import bootstrap_fits, interval_table
 
         draws = bootstrap_fits(spec, fit, av.n, factors, av.type, edf, weights, replicates, rng)
         table = interval_table(spec, fit.theta, draws, alpha)

@@ -4,7 +4,7 @@ Per-sample parameters (:mod:`avar.models`), at averaging factors m: QN 3 / m^2,
 WN 1 / m, FN flicker (exact sums up to m = 4096, then its expansion), RW
 (2 m^2 + 1) / (6 m), DR m^2 / 2, AR1 Zhang's closed form, SIN a sinusoid of
 frequency f cycles per sample. The deviance and the levels' weights of
-:mod:`avar.fit.sensor_fit` are here too.
+:mod:`avar.fit.report.sensor_fit` are here too.
 """
 
 from __future__ import annotations
@@ -118,7 +118,7 @@ class Component:
 
 #: Correlation of maximal-overlap Allan variance estimates 1, 2, ... 8 octaves apart, by the power-law
 #: noise alpha of the coarser level (2 white PM / quantization, 0 white FM, -1 flicker FM, -2 random
-#: walk FM): the exact Gaussian covariance (:func:`avar.fit.gmwm_covariance.mo_av_covariance`, with the
+#: walk FM): the exact Gaussian covariance (:func:`avar.fit.gmwm.covariance.mo_av_covariance`, with the
 #: flicker increments' autocovariance for alpha = -1) at m = 16 of N = 2^16, where it no longer depends
 #: on m or N (tests/fit/test_sensor_fit.py recomputes it).
 OCTAVE_CORRELATION = {

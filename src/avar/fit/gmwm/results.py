@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from avar._frozen import frozen_array, frozen_frame, frozen_mapping, frozen_series
-from avar.fit.gmwm_model import continuous_parameters
+from avar.fit.gmwm.model import continuous_parameters
 from avar.models import NoiseModel
 from avar.stability.results import AllanVariance, ImuAllanVariance
 
@@ -76,7 +76,7 @@ class GmwmResult:
 
     @property
     def continuous(self) -> pd.Series:
-        """Continuous-time parameters at the data's rate (see :func:`~avar.fit.gmwm_model.continuous_parameters`).
+        """Continuous-time parameters at the data's rate (see :func:`~avar.fit.gmwm.model.continuous_parameters`).
 
         WN sigma [u s^1/2], QN Q [u s], RW gamma [u s^-1/2], DR omega [u s^-1],
         AR1 correlation time T [s] and stationary deviation sigma_s [u].

@@ -4,7 +4,7 @@ Holds numbers only: the Allan variance and the selected model of every
 channel, the table of terms, the curves (empirical deviation, band, implied
 deviation) and the warnings. ``plot()`` draws the report
 figure (:mod:`avar.plotting.report`), ``to_kalibr(path)`` writes a Kalibr
-``imu.yaml`` (:mod:`avar.fit.kalibr`).
+``imu.yaml`` (:mod:`avar.fit.report.kalibr`).
 """
 
 from __future__ import annotations
@@ -135,20 +135,20 @@ class NoiseReport:
         raise ValueError(f"implied must be 'sum' (sum of the processes' variances) or 'r' (R's curve), got {implied!r}")
 
     def kalibr(self, **overrides: Any) -> dict[str, Any]:
-        """The Kalibr ``imu.yaml`` fields; see :func:`avar.fit.kalibr.kalibr_fields`."""
-        from avar.fit.kalibr import kalibr_fields
+        """The Kalibr ``imu.yaml`` fields; see :func:`avar.fit.report.kalibr.kalibr_fields`."""
+        from avar.fit.report.kalibr import kalibr_fields
 
         return kalibr_fields(self, **overrides)
 
     def kalibr_text(self, axis: str = "max", **overrides: Any) -> str:
-        """The Kalibr ``imu.yaml`` text with its comments; see :func:`avar.fit.kalibr.kalibr_text`."""
-        from avar.fit.kalibr import kalibr_text
+        """The Kalibr ``imu.yaml`` text with its comments; see :func:`avar.fit.report.kalibr.kalibr_text`."""
+        from avar.fit.report.kalibr import kalibr_text
 
         return kalibr_text(self, axis=axis, **overrides)
 
     def to_kalibr(self, path: Any, force: bool = False, **overrides: Any) -> Any:
-        """Write a Kalibr ``imu.yaml``; see :func:`avar.fit.kalibr.write_kalibr`."""
-        from avar.fit.kalibr import write_kalibr
+        """Write a Kalibr ``imu.yaml``; see :func:`avar.fit.report.kalibr.write_kalibr`."""
+        from avar.fit.report.kalibr import write_kalibr
 
         return write_kalibr(self, path, force=force, **overrides)
 

@@ -56,7 +56,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avar.fit.sensor_terms import KINDS, LINEAR, Component, basis, deviance, level_correlation, weight_edf
+from avar.fit.report.sensor_terms import KINDS, LINEAR, Component, basis, deviance, level_correlation, weight_edf
 
 __all__ = ["SensorFit", "fit_sensor_model", "term_bound", "with_sampling_edf"]
 
@@ -66,7 +66,7 @@ MAX_COPIES = {"AR1": 2, "SIN": 2}
 GRID_PER_OCTAVE = 1
 #: Rounds of stepwise selection and shape polishing.
 PASSES = 3
-#: Share of the levels that must fit (see :func:`avar.fit.report_checks.fit_check`).
+#: Share of the levels that must fit (see :func:`avar.fit.report.checks.fit_check`).
 FIT_SHARE = 0.90
 #: Relative change of the model at which a scan's reweighting stops (rankings need no more).
 SCAN_TOLERANCE = 1e-4
@@ -303,7 +303,7 @@ def fit_sensor_model(factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, *
     penalty : float, optional
         Criterion penalty per parameter (default: log of the summed edf).
     kinds : tuple of str
-        The terms allowed (default all of :data:`~avar.fit.sensor_terms.KINDS`).
+        The terms allowed (default all of :data:`~avar.fit.report.sensor_terms.KINDS`).
     check : callable, optional
         ``check(implied_av) -> share`` of the levels where a model fits the data. When the selected
         model's share is below 90 %, terms are added (each kind tried, the best share kept) while the
