@@ -188,3 +188,14 @@ def test_spikes_are_warned_about_and_the_robust_report_gives_the_clean_terms():
     for process in ("WN", "RW"):
         assert robust.value("x", process) == pytest.approx(truth.value("x", process), rel=0.10)
     assert any("sets them aside" in w for w in robust.warnings)
+
+
+def test_a_time_indexed_series_gives_its_rate_to_the_plain_and_the_robust_report():
+    x = WN(sigma2=1e-4).simulate(40_000, seed=3)
+    series = pd.Series(x, index=pd.date_range("2026-01-01", periods=x.size, freq="10ms"))
+    plain = avar.noise_report(x, gyro_units="rad/s", freq=100.0)
+    for report in (avar.noise_report(series, gyro_units="rad/s"),
+                   avar.noise_report(series, gyro_units="rad/s", robust=True)):
+        assert report.freq == 100.0
+        np.testing.assert_array_equal(report.avs["x"].levels, plain.avs["x"].levels)
+        assert report.value("x", "WN") == pytest.approx(plain.value("x", "WN"), rel=1e-9)

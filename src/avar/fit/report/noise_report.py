@@ -122,7 +122,7 @@ def _channels(x: Any, freq: Any, gyro: Any, accel: Any, taus: Any, type: str, si
     name = getattr(x, "name", None) if isinstance(x, pd.Series) else None
     series, rate = as_series(x, freq)
     series = np.asarray(series, dtype=np.float64)
-    av = estimate(x, rate if freq is None and not isinstance(x, pd.Series) else freq, _grid(taus, series.size, rate))
+    av = estimate(series, rate, _grid(taus, series.size, rate))  # the rate of freq, else of a time index, else 1 Hz
     return [(str(name) if name is not None else "x", single_kind, av, series)], None, None
 
 
