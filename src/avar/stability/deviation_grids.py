@@ -133,3 +133,23 @@ def deviation_factors(estimator: str, n_phase: int, rate: float = 1.0, taus: Any
     return grid_factors(taus, rate, largest, first_octave=0,
                         context=f"of {estimator} (averaging factors 1..{largest} at rate = {rate:g} Hz "
                                 f"with {n_phase} phase points)")
+
+
+def levels_with_terms(statistic: str, n: np.ndarray, arrays: tuple, missing: str | None) -> tuple:
+    """``(n, *arrays)`` cut to the levels with at least one term, the first array the variances.
+
+    ``missing`` names the data's NaN values when there are any (only then can a
+    level lose every term): no level left is an error naming them. Variances
+    that overflowed are an error too.
+
+    >>> levels_with_terms("adev", np.array([3, 0]), (np.array([1.0, 2.0]),), "the 1 NaN value(s) of data")
+    (array([3]), array([1.]))
+    """
+    if missing is not None:
+        keep = n > 0
+        if not keep.any():
+            raise ValueError(f"no {statistic} term avoids {missing} at these taus")
+        n, arrays = n[keep], tuple(a[keep] for a in arrays)
+    if not np.all(np.isfinite(arrays[0])):
+        raise ValueError(f"{statistic} overflows float64; rescale the data, e.g. to other units")
+    return (n, *arrays)

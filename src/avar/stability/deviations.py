@@ -34,7 +34,7 @@ import pandas as pd
 from avar._kernels.deviation_phase import scan
 from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, rate_from_index, short_repr
 from avar.stability.deviation_core import OctaveMoments, deviation_levels_and_phase
-from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors
+from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors, levels_with_terms
 from avar.stability.deviation_results import Deviation
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.noise_id import NOISE_ID_ESTIMATORS, identify_noise, octave_noise, phase_noise
@@ -199,13 +199,8 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     factors = deviation_factors(estimator, n_phase, rate, taus)
     values, scanned, exponent = _scaled(values, scanned, drift_removed)
     variance, n, phase, drift = deviation_levels_and_phase(estimator, values, factors, data_type, rate, scanned)
-    if n_missing:
-        keep = n > 0
-        if not keep.any():
-            raise ValueError(f"no {estimator} term avoids the {n_missing} NaN value(s) of data at these taus")
-        factors, variance, n = factors[keep], variance[keep], n[keep]
-    if not np.all(np.isfinite(variance)):
-        raise ValueError(f"{estimator} overflows float64; rescale the data, e.g. to other units")
+    n, variance, factors = levels_with_terms(estimator, n, (variance, factors),
+                                             f"the {n_missing} NaN value(s) of data" if n_missing else None)
     deviation = np.ldexp(np.sqrt(variance), exponent)
     if exponent:
         with np.errstate(over="ignore", under="ignore"):

@@ -17,6 +17,7 @@ import numpy as np
 
 from avar._kernels.time_error import mtie_levels, pdev_levels, tierms_levels
 from avar._validation import short_repr
+from avar.stability.deviation_grids import levels_with_terms
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import _check_data, _check_options, _noise_of_levels, noise_exponents
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
@@ -103,12 +104,8 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         if statistic == "pdev":
             variance = variance / (m / rate) ** 2
         deviation = np.sqrt(variance)
-    keep = n > 0
-    if not keep.any():
-        raise ValueError(f"no {statistic} term avoids the {int(gaps[-1])} NaN value(s) of data at these taus")
-    factors, deviation, variance, n = factors[keep], deviation[keep], variance[keep], n[keep]
-    if not np.all(np.isfinite(variance)):
-        raise ValueError(f"{statistic} overflows float64; rescale the data, e.g. to other units")
+    n, variance, factors, deviation = levels_with_terms(statistic, n, (variance, factors, deviation),
+                                                        f"the {int(gaps[-1])} NaN value(s) of data")
     alpha_levels = level_noise(fixed, values, phase, gaps, data_type, rate, factors)
     if statistic == "pdev":
         edf = pdev_edf(alpha_levels, factors, n_phase)

@@ -18,6 +18,7 @@ import numpy as np
 from avar._kernels.theo_fft import theo1_sums
 from avar._kernels.total import level_sums, theo1_sum
 from avar.stability.deviation_core import phase_parts
+from avar.stability.deviation_grids import levels_with_terms
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options, noise_exponents
 from avar.stability.edf import chi2_bounds
@@ -143,13 +144,8 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
         raise ValueError(f"data has too few points for any {estimator} level (largest factor "
                          f"{largest_factor(estimator, n_phase)})")
     variance, n = raw_variances(estimator, x, factors, bad, shift, scale, rate, data_type == "phase")
-    if bad.size:
-        keep = n > 0
-        if not keep.any():
-            raise ValueError(f"no {estimator} term avoids the NaN values of data at these taus")
-        factors, variance, n = factors[keep], variance[keep], n[keep]
-    if not np.all(np.isfinite(variance)):
-        raise ValueError(f"{estimator} overflows float64; rescale the data, e.g. to other units")
+    n, variance, factors = levels_with_terms(estimator, n, (variance, factors),
+                                             "the NaN values of data" if bad.size else None)
     if alpha is None:
         noise_factors = np.maximum(1, np.round(0.75 * factors)).astype(np.int64) if estimator == "theo1" else factors
         alphas = noise_exponents(_NOISE_RULES[estimator], values, data_type, rate, noise_factors)
