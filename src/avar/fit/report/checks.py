@@ -88,13 +88,13 @@ def data_warnings(channel: str, kind: str | None, values: np.ndarray, freq: floa
     if n < 2:
         return out
     low, high = float(np.min(x)), float(np.max(x))
+    steps = np.diff(x)
     if high > low:
         for edge, name in ((high, "maximum"), (low, "minimum")):
             share = float(np.mean(x == edge))
             if share > 0.001 and share * n >= 10:
                 out.append(f"{channel}: {100 * share:.3g} % of the samples sit at the {name} {edge:.6g} "
                            "(clipped or saturated); the noise terms are unreliable")
-        steps = np.diff(x)
         repeated = float(np.mean(steps == 0.0))
         distinct = np.unique(x[: min(n, 100_000)]).size
         if repeated > 0.5 and distinct > 8:
@@ -116,7 +116,7 @@ def data_warnings(channel: str, kind: str | None, values: np.ndarray, freq: floa
     if kind in (GYRO, ACCEL) and window >= 1 and n >= 8 * window and high > low:
         means = x[: (n // window) * window].reshape(-1, window).mean(axis=1)
         drift = float(np.max(means) - np.min(means))
-        white = 1.4826 * float(np.median(np.abs(np.diff(x)))) / math.sqrt(2.0 * window)  # sample noise over 1 s
+        white = 1.4826 * float(np.median(np.abs(steps))) / math.sqrt(2.0 * window)  # sample noise over 1 s
         if white > 0 and drift > MOVING_RATIO * white:
             out.append(f"{channel}: the 1 s means range over {drift:.3g}, {drift / white:.0f} times their noise: "
                        "the log moves or drifts strongly (the noise report assumes a sensor at rest)")

@@ -218,11 +218,12 @@ class _Problem:
             return self.solve(unpack(np.clip(free, -40.0, 40.0)))[1]
 
         start = pack(terms)
+        at_start = objective(start)
         found = minimize(objective, start, method="Nelder-Mead",
                          options={"xatol": 1e-4, "fatol": 1e-6, "maxfev": 150 * len(shaped)})
-        best = found.x if found.fun < objective(start) else start
-        refined = unpack(np.clip(best, -40.0, 40.0))
-        return refined, self.solve(refined)[1]
+        if found.fun < at_start:
+            return unpack(np.clip(found.x, -40.0, 40.0)), float(found.fun)
+        return unpack(np.clip(start, -40.0, 40.0)), at_start
 
 
 def _size(terms: list[tuple[str, float | None]]) -> int:
