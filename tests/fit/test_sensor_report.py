@@ -14,11 +14,10 @@ import pytest
 
 import avar
 from avar.fit.gmwm import octave_factors
-from avar.fit.gmwm.covariance import mo_av_covariance
 from avar.fit.report.checks import data_warnings, fit_check, unit_warnings
 from avar.fit.report.sensor_fit import fit_sensor_model, term_bound
-from avar.fit.report.sensor_terms import OCTAVE_CORRELATION, basis, flicker_unit_av, level_correlation
-from avar.models import AR1, QN, RW, SIN, WN
+from avar.fit.report.sensor_terms import basis, flicker_unit_av
+from avar.models import AR1, SIN, WN
 from avar.models.flicker import av_fn
 
 FREQ = 200.0
@@ -113,18 +112,6 @@ def test_the_flicker_expansion_and_the_sinusoid_theory():
     factors = np.array([1, 5, 20, 37, 80])
     empirical = avar.avar(x, taus=factors.astype(float)).allan
     np.testing.assert_allclose(empirical, s.theoretical_av(factors), rtol=2e-3, atol=1e-6)
-
-
-@pytest.mark.parametrize("alpha, model", [(0, WN(sigma2=1.0)), (-2, RW(gamma2=1.0)), (2, QN(q2=1.0))])
-def test_the_octave_correlation_table_is_the_exact_covariance(alpha, model):
-    factors = 2 ** np.arange(2, 9)
-    cov = mo_av_covariance(model, 2**14, factors)
-    spread = np.sqrt(np.diag(cov))
-    exact = cov / np.outer(spread, spread)
-    for distance in (1, 2, 3):
-        assert exact[2, 2 + distance] == pytest.approx(OCTAVE_CORRELATION[alpha][distance - 1], abs=0.02)
-    table = level_correlation(factors, np.full(factors.size, alpha))
-    assert np.all(np.linalg.eigvalsh(table) > -1e-9) or alpha == 2
 
 
 def test_a_model_that_cannot_fit_is_flagged():

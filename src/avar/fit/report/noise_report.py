@@ -24,7 +24,7 @@ from avar.fit.report.checks import FIT_SHARE, data_warnings, fit_check, unit_war
 from avar.fit.report.noise_terms import ACCEL, GYRO, check_unit
 from avar.fit.report.result import NoiseReport
 from avar.fit.report.rows import channel_rows, minimum_row
-from avar.fit.report.sensor_fit import SensorFit, fit_sensor_model, with_sampling_edf
+from avar.fit.report.sensor_fit import SensorFit, fit_sensor_model, with_level_covariance
 from avar.imu import IMU
 from avar.stability.allan import avar as allan_variance
 from avar.stability.results import AllanVariance, ImuAllanVariance
@@ -130,9 +130,11 @@ def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray,
     """The selected model of one Allan variance and its 1 - alpha band (lower, upper deviation).
 
     The fit weighs the levels by their degrees of freedom (N - 2m + 1) / m;
-    the band and the parameters' covariance then use Greenhall's EDF of the
-    overlapping Allan variance at the noise type of the fitted model's local
-    slope (alpha = -1 - d log AV / d log tau, rounded into -2..2). When the
+    the band uses Greenhall's EDF of the overlapping Allan variance at the
+    noise type of the fitted model's local slope (alpha = -1 - d log AV / d log
+    tau, rounded into -2..2); the parameters' covariance, the exact covariance
+    of the levels under the selected model
+    (:func:`~avar.fit.report.sensor_fit.with_level_covariance`). When the
     selected model fits fewer than 90 % of the levels, the selection is
     extended by the terms the data demand (``check`` of
     :func:`~avar.fit.report.sensor_fit.fit_sensor_model`).
@@ -141,28 +143,31 @@ def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray,
     counts = np.maximum(av.n - 2 * factors + 1, 1)
     nu_hat, adev = np.asarray(av.allan, dtype=np.float64), np.asarray(av.adev, dtype=np.float64)
     fit = fit_sensor_model(factors, nu_hat, counts / factors)
-    lower, upper, edf, noise = _band(av, fit.implied(factors), alpha)
+    lower, upper, edf = _band(av, fit.implied(factors), alpha)
 
     def share(implied: np.ndarray) -> float:
         return float(np.mean(fit_check("", av.levels, adev, lower, upper, np.sqrt(implied))[0]))
 
     if share(fit.implied(factors)) < FIT_SHARE:
         fit = fit_sensor_model(factors, nu_hat, counts / factors, check=share)
-        lower, upper, edf, noise = _band(av, fit.implied(factors), alpha)
-    return with_sampling_edf(fit, edf, noise), lower, upper
+        lower, upper, edf = _band(av, fit.implied(factors), alpha)
+    # "to" estimates have fewer terms: Greenhall's variances, the maximal-overlap correlation
+    variances = None if av.type == "mo" else 2.0 * fit.implied(factors) ** 2 / edf
+    return with_level_covariance(fit, av.n, variances), lower, upper
 
 
-def _band(av: AllanVariance, implied: np.ndarray, alpha: float) -> tuple[np.ndarray, ...]:
-    """Lower and upper 1 - alpha chi-squared bounds of the deviation, Greenhall's EDF at the model's noise
-    types, and those types (power-law alpha: AV slope mu gives -1 - mu, and 2 (white PM) below -1.5)."""
+def _band(av: AllanVariance, implied: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Lower and upper 1 - alpha chi-squared bounds of the deviation and Greenhall's EDF, at the model's noise
+    types (power-law alpha: AV slope mu gives -1 - mu, and 2 (white PM) below -1.5), for the estimator's
+    overlap."""
     from avar.stability.edf import chi2_bounds, greenhall_edf
 
     factors = np.asarray(av.averaging_factors, dtype=np.int64)
     slope = np.gradient(np.log(implied), np.log(factors)) if factors.size > 1 else np.zeros(1)
     noise = np.where(slope < -1.5, 2, np.clip(np.rint(-1.0 - slope), -2, 1)).astype(np.int64)
-    edf = greenhall_edf(noise, 2, factors, av.n + 1, overlapping=True, modified=False)
+    edf = greenhall_edf(noise, 2, factors, av.n + 1, overlapping=av.type == "mo", modified=False)
     lower, upper = chi2_bounds(np.sqrt(av.allan), edf, 1.0 - alpha)
-    return np.asarray(lower), np.asarray(upper), np.asarray(edf), noise
+    return np.asarray(lower), np.asarray(upper), np.asarray(edf)
 
 
 def noise_report(

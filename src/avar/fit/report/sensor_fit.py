@@ -56,9 +56,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avar.fit.report.sensor_terms import KINDS, LINEAR, Component, basis, deviance, level_correlation, weight_edf
+from avar.fit.report.level_covariance import level_covariance
+from avar.fit.report.sensor_terms import KINDS, LINEAR, Component, basis, deviance, weight_edf
 
-__all__ = ["SensorFit", "fit_sensor_model", "term_bound", "with_sampling_edf"]
+__all__ = ["SensorFit", "fit_sensor_model", "term_bound", "with_level_covariance"]
 
 #: How many of each shaped term a model may hold.
 MAX_COPIES = {"AR1": 2, "SIN": 2}
@@ -88,6 +89,9 @@ class SensorFit:
         The fitted deviance and the penalized criterion that selected the model.
     penalty : float
         Penalty per parameter of the criterion.
+    levels : ndarray or None
+        Covariance of the Allan variance estimates under the selected model
+        (:func:`with_level_covariance`); None: independent levels of ``edf`` degrees of freedom.
     """
 
     components: tuple[Component, ...]
@@ -98,6 +102,7 @@ class SensorFit:
     deviance: float
     criterion: float
     penalty: float
+    levels: np.ndarray | None = None
 
     def implied(self, m: np.ndarray | None = None) -> np.ndarray:
         """The model's Allan variance at ``m`` (default: the fitted factors)."""
@@ -347,21 +352,20 @@ def fit_sensor_model(factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, *
     scales, current = problem.solve(terms)
     kept = [(t, c) for t, c in zip(terms, scales) if c > 0]
     components = tuple(Component(kind, float(c), shape) for (kind, shape), c in kept)
-    covariance = _covariance(components, factors, edf, sampling_edf)
+    covariance = _covariance(components, factors, edf, _independent(components, factors, sampling_edf))
     return SensorFit(components=components, covariance=covariance, factors=factors, nu_hat=nu_hat, edf=sampling_edf,
                      deviance=current, criterion=current + penalty * _size([(c.kind, c.shape) for c in components]),
                      penalty=penalty)
 
 
 def _covariance(components: tuple[Component, ...], factors: np.ndarray, edf: np.ndarray,
-                sampling_edf: np.ndarray | None = None, correlation: np.ndarray | None = None) -> np.ndarray:
-    """Covariance of (scales, shapes): the sandwich of the fit's weights around the levels' covariance.
+                levels: np.ndarray) -> np.ndarray:
+    """Covariance of (scales, shapes): the sandwich of the fit's weights around the ``levels``' covariance.
 
     The fit weighs level j by ``edf`` (capped by the model-discrepancy floor);
-    the estimates vary with the levels' covariance S = D R D, D = diag(nu sqrt(2 / ``sampling_edf``)),
-    R the ``correlation`` of the levels (default independent):
+    the estimates then vary with the covariance S of the Allan variance estimates:
     Cov = A^-1 J' W S W J A^-1, W = diag(edf / (2 nu^2)), A = J' W J
-    (the inverse Fisher information when both edf are equal and the levels independent).
+    (the inverse Fisher information when S = diag(2 nu^2 / edf)).
     """
     columns = [basis(c.kind, c.shape, factors) for c in components]
     jacobian = list(columns)
@@ -379,25 +383,35 @@ def _covariance(components: tuple[Component, ...], factors: np.ndarray, edf: np.
     norms = np.linalg.norm(design / nu[:, None], axis=0)
     norms[norms == 0] = 1.0
     design = design / norms
-    information = design.T @ (design * (edf / (2.0 * nu**2))[:, None])
-    bread = np.linalg.pinv(information)
-    if sampling_edf is not None:
-        weighted = design * (edf / (2.0 * nu**2))[:, None]
-        spread = nu * np.sqrt(2.0 / sampling_edf)
-        levels = np.outer(spread, spread) * (np.eye(nu.size) if correlation is None else correlation)
-        bread = bread @ (weighted.T @ levels @ weighted) @ bread
-    return bread / np.outer(norms, norms)
+    weighted = design * (edf / (2.0 * nu**2))[:, None]
+    bread = np.linalg.pinv(design.T @ weighted)
+    return (bread @ (weighted.T @ levels @ weighted) @ bread) / np.outer(norms, norms)
 
 
-def with_sampling_edf(fit: SensorFit, sampling_edf: np.ndarray, noise: np.ndarray | None = None) -> SensorFit:
-    """The same fit with its covariance for other sampling degrees of freedom (e.g. Greenhall's EDF)
-    and, given the levels' power-law ``noise`` types, their correlation (:func:`level_correlation`)."""
+def _independent(components: tuple[Component, ...], factors: np.ndarray, edf: np.ndarray) -> np.ndarray:
+    """Covariance of independent Allan variance estimates of ``edf`` degrees of freedom: diag(2 nu^2 / edf)."""
+    nu = np.sum([c.av(factors) for c in components], axis=0) if components else np.ones(factors.size)
+    return np.diag(2.0 * nu**2 / edf)
+
+
+def with_level_covariance(fit: SensorFit, n: int, variances: np.ndarray | None = None) -> SensorFit:
+    """The same fit with its parameters' covariance from the exact covariance of the levels.
+
+    The levels' covariance is that of the selected model itself
+    (:func:`~avar.fit.report.level_covariance.level_covariance`: every term's
+    contribution at every level and the correlation between levels, for a
+    maximal-overlap estimate from ``n`` samples), so the sandwich is right where
+    terms mix. Given ``variances`` (another estimator's, e.g. the non-overlapping
+    one's from Greenhall's EDF), the levels keep that correlation with these variances.
+    """
     import dataclasses
 
-    sampling_edf = np.maximum(np.asarray(sampling_edf, dtype=np.float64), 1.0)
-    correlation = None if noise is None else level_correlation(fit.factors, np.asarray(noise))
-    covariance = _covariance(fit.components, fit.factors, weight_edf(fit.edf), sampling_edf, correlation)
-    return dataclasses.replace(fit, covariance=covariance, edf=sampling_edf)
+    levels = level_covariance(fit.components, int(n), fit.factors)
+    if variances is not None:
+        scale = np.sqrt(np.asarray(variances, dtype=np.float64) / np.diag(levels))
+        levels = levels * np.outer(scale, scale)
+    covariance = _covariance(fit.components, fit.factors, weight_edf(fit.edf), levels)
+    return dataclasses.replace(fit, covariance=covariance, levels=levels)
 
 
 def term_bound(fit: SensorFit, kind: str, level: float = 0.95) -> float:
@@ -413,8 +427,9 @@ def term_bound(fit: SensorFit, kind: str, level: float = 0.95) -> float:
     terms = [(c.kind, c.shape) for c in fit.components] + [(kind, None)]
     scales, _ = problem.solve(terms)
     components = [Component(k, max(float(c), 0.0), s) for (k, s), c in zip(terms, scales)]
-    floor = [Component(c.kind, max(c.scale, 1e-300), c.shape) for c in components]
-    covariance = _covariance(tuple(floor), fit.factors, weight_edf(fit.edf), fit.edf)
+    floor = tuple(Component(c.kind, max(c.scale, 1e-300), c.shape) for c in components)
+    levels = _independent(floor, fit.factors, fit.edf) if fit.levels is None else fit.levels
+    covariance = _covariance(floor, fit.factors, weight_edf(fit.edf), levels)
     at = len(terms) - 1
     spread = math.sqrt(max(float(covariance[at, at]), 0.0))
     return components[at].scale + float(norm.ppf(level)) * spread

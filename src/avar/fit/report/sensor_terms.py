@@ -19,8 +19,7 @@ from avar.models.flicker import FLICKER_AV_FACTOR, av_fn
 from avar.models.sinusoid import av_sin
 from avar.models.theory import ar1_unit_av
 
-__all__ = ["KINDS", "LINEAR", "DISCREPANCY", "Component", "basis", "deviance", "weight_edf", "flicker_unit_av",
-           "level_correlation"]
+__all__ = ["KINDS", "LINEAR", "DISCREPANCY", "Component", "basis", "deviance", "weight_edf", "flicker_unit_av"]
 
 #: Terms in report order: IEEE 952's five, then Gauss-Markov and sinusoidal terms.
 KINDS = ("QN", "WN", "FN", "RW", "DR", "AR1", "SIN")
@@ -114,39 +113,3 @@ class Component:
     def av(self, m: np.ndarray) -> np.ndarray:
         """Its Allan variance at factors ``m``."""
         return self.scale * basis(self.kind, self.shape, m)
-
-
-#: Correlation of maximal-overlap Allan variance estimates 1, 2, ... 8 octaves apart, by the power-law
-#: noise alpha of the coarser level (2 white PM / quantization, 0 white FM, -1 flicker FM, -2 random
-#: walk FM): the exact Gaussian covariance (:func:`avar.fit.gmwm.covariance.mo_av_covariance`, with the
-#: flicker increments' autocovariance for alpha = -1) at m = 16 of N = 2^16, where it no longer depends
-#: on m or N (tests/fit/test_sensor_fit.py recomputes it).
-OCTAVE_CORRELATION = {
-    2: (0.400, 0.514, 0.514, 0.513, 0.511, 0.508, 0.502, 0.490),
-    0: (0.530, 0.187, 0.066, 0.023, 0.008, 0.003, 0.001, 0.0),
-    -1: (0.689, 0.309, 0.121, 0.045, 0.016, 0.006, 0.002, 0.001),
-    -2: (0.887, 0.675, 0.487, 0.346, 0.244, 0.171, 0.120, 0.082),
-}
-
-
-def level_correlation(factors: np.ndarray, noise: np.ndarray) -> np.ndarray:
-    """Correlation matrix of the Allan variance estimates at ``factors`` with noise types ``noise``.
-
-    The entry for levels j < k is :data:`OCTAVE_CORRELATION` of the noise at the
-    coarser level k, interpolated at their distance log2(m_k / m_j) in octaves
-    (0 beyond eight octaves, and for a noise type not in the table: the nearest one).
-
-    >>> level_correlation(np.array([1, 2, 4]), np.array([0, 0, -2])).round(3).tolist()
-    [[1.0, 0.53, 0.675], [0.53, 1.0, 0.887], [0.675, 0.887, 1.0]]
-    """
-    factors = np.asarray(factors, dtype=np.float64)
-    octaves = np.log2(factors)
-    known = np.array(sorted(OCTAVE_CORRELATION))
-    out = np.eye(factors.size)
-    for k in range(factors.size):
-        nearest = int(known[np.argmin(np.abs(known - noise[k]))])
-        table = np.concatenate(([1.0], OCTAVE_CORRELATION[nearest], [0.0]))
-        for j in range(k):
-            distance = abs(octaves[k] - octaves[j])
-            out[j, k] = out[k, j] = float(np.interp(distance, np.arange(table.size), table))
-    return out

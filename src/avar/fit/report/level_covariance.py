@@ -1,0 +1,232 @@
+"""Covariance of the maximal-overlap Allan variance estimates of a fitted noise model: :func:`level_covariance`.
+
+The sandwich intervals of :mod:`avar.fit.report.sensor_fit` need the
+covariance of the estimates nu_hat(m_j) across levels. Tables of pure power
+laws (one noise type per level) misstate it where terms mix, which is where a
+sensor's random walk and bias instability are read. This module computes it
+for the fitted sum of processes itself, as the exact Gaussian covariance
+(the formula of :func:`avar.fit.gmwm.covariance.mo_av_covariance`)::
+
+    Cov(nu_hat_j, nu_hat_k) = 1 / (M_j M_k) sum_h c_jk(h) [2 gamma_jk(h)^2 + 4 mu_j mu_k gamma_jk(h)],
+
+with M_j = N - 2 m_j + 1 terms, c_jk(h) the number of pairs at lag h, mu the
+means a ramp gives, and gamma_jk the cross-covariance of the Allan-filtered
+series W_s(m) = (ybar_{s+m} - ybar_s) / sqrt(2). Every term has stationary
+increments, so gamma_jk follows from the structure function
+D(k) = Var(y_{t+k} - y_t) of the whole model (the sum of its terms')::
+
+    Cov(y_a - y_b, y_c - y_d) = [D(a - d) + D(b - c) - D(a - c) - D(b - d)] / 2,
+    sum_{i<L1} sum_{l<L2} D(c + i - l) = S2(c + L1 + 1) - S2(c + L1 - L2 + 1) - S2(c + 1) + S2(c - L2 + 1),
+
+S2 the second cumulative sum of D (summed outward from 0), so
+gamma_jk(h) costs 16 table reads at any m. The sum over h runs exactly near
+the kinks of gamma_jk and c_jk and by the trapezoid rule on integer nodes in
+between (the summand is smooth there), a few thousand evaluations per pair of
+levels whatever N.
+
+Per-sample structure functions: QN 6 q2 at lag 1, 4 q2 beyond; WN 2 sigma2;
+FN (4 b2 / pi) sum_{j<=k} 1 / (2 j - 1); RW gamma2 |k|; AR1 2 (c(0) - c(k)),
+c(k) = phi^k / (1 - phi^2). DR contributes the mean mu_m = sqrt(omega2 / 2) m
+of the ramp (its AV is omega2 m^2 / 2).
+
+A sinusoid (SIN) of fixed amplitude and random phase is not Gaussian: its
+share of a level's estimate hardly varies between records (a Gaussian line
+would have a random amplitude and about one degree of freedom), so it is
+left out of the covariance. Its cross terms with the noise,
+(4 / M) sum_h gamma_noise(h) gamma_sin(h), are left out with it: they matter
+only at the few levels the sinusoid dominates, where its own interval
+(from the same sandwich) is then too narrow.
+
+References
+----------
+D. B. Percival, A. T. Walden, Wavelet Methods for Time Series Analysis, 2000, ch. 8.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from avar.fit.report.sensor_terms import Component
+
+__all__ = ["level_covariance", "structure_function", "MAX_EXACT_LEVELS"]
+
+#: Integers summed exactly on each side of a kink of the summand.
+DENSE = 24
+#: Trapezoid nodes between two kinks.
+NODES = 96
+#: Levels computed pair by pair; a denser grid is interpolated from this many log-spaced ones.
+MAX_EXACT_LEVELS = 40
+#: Lags beyond the filters' reach kept for terms of infinite memory (flicker, Gauss-Markov), in filter lengths.
+TAIL = 4
+
+
+def structure_function(components: Sequence[Component], size: int) -> np.ndarray:
+    """D(k), k = 0..size, of the Gaussian terms of ``components`` (per-sample parameters; no DR, no SIN).
+
+    >>> structure_function([Component("WN", 1.0), Component("RW", 0.5)], 3).tolist()
+    [0.0, 2.5, 3.0, 3.5]
+    """
+    out = np.zeros(size + 1)
+    for c in components:
+        if c.kind in UNIT_KINDS:
+            out += c.scale * _unit_structure(c.kind, size)
+        elif c.kind == "AR1":
+            k = np.arange(size + 1, dtype=np.float64)
+            phi = float(c.shape)
+            out += 2.0 * c.scale * (-np.expm1(k * math.log(phi))) / ((1.0 - phi) * (1.0 + phi))
+        elif c.kind not in ("DR", "SIN"):
+            raise ValueError(f"no structure function for a {c.kind!r} term")
+    return out
+
+
+#: Terms whose structure function is their scale times a fixed function of the lag.
+UNIT_KINDS = ("QN", "WN", "FN", "RW")
+
+
+@functools.lru_cache(maxsize=4)
+def _unit_structure(kind: str, size: int) -> np.ndarray:
+    out = np.zeros(size + 1)
+    if kind == "QN":
+        out[1:2], out[2:] = 6.0, 4.0
+    elif kind == "WN":
+        out[1:] = 2.0
+    elif kind == "FN":  # (4 / pi) sum_{j<=k} 1 / (2 j - 1)
+        out[1:] = np.cumsum(4.0 / (math.pi * (2.0 * np.arange(1, size + 1) - 1.0)))
+    else:
+        out[:] = np.arange(size + 1, dtype=np.float64)
+    out.flags.writeable = False
+    return out
+
+
+def _second_sums(structure: np.ndarray) -> np.ndarray:
+    """S2(x) for x = 0..R with S1(x + 1) - S1(x) = D(x), S2(x + 1) - S2(x) = S1(x), S1(0) = S2(0) = 0.
+
+    Summed outward from 0, so values near 0 carry no rounding of large ones; D is
+    even, so S2(-x) = S2(x + 2) for x > 0 and one side suffices.
+    """
+    s1 = np.concatenate([[0.0], np.cumsum(structure)])
+    return np.concatenate([[0.0], np.cumsum(s1)])
+
+
+def _s2(table: np.ndarray, x: np.ndarray) -> np.ndarray:
+    return table[np.where(x < 0, 2 - x, x)]
+
+
+def _nodes(low: int, high: int, kinks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Integer nodes in [low, high] and weights w with sum_h F(h) ~ sum w F(node), F linear between nodes."""
+    dense = (kinks[:, None] + np.arange(-DENSE, DENSE + 1)[None, :]).ravel()
+    marks = np.unique(np.clip(np.concatenate([dense, [low, high]]), low, high))
+    pieces = [marks]
+    gaps = np.diff(marks)
+    for a, g in zip(marks[:-1][gaps > 1], gaps[gaps > 1]):
+        pieces.append(a + np.unique(np.linspace(0, g, min(NODES, g) + 1).round().astype(np.int64)))
+    nodes = np.unique(np.concatenate(pieces))
+    gap = np.diff(nodes).astype(np.float64)
+    weights = np.ones(nodes.size)
+    weights[:-1] += (gap - 1.0) / 2.0
+    weights[1:] += (gap - 1.0) / 2.0
+    return nodes, weights
+
+
+def level_covariance(components: Sequence[Component], n: int, factors: np.ndarray) -> np.ndarray:
+    """Gaussian covariance of the maximal-overlap AV estimates of a sum of terms at averaging ``factors``.
+
+    Parameters
+    ----------
+    components : sequence of Component
+        The model's terms, per-sample parameters (:mod:`avar.fit.report.sensor_terms`).
+    n : int
+        Series length N (samples).
+    factors : ndarray of int
+        Averaging factors m_j, 1 <= m_j <= (N - 1) / 2.
+
+    Returns
+    -------
+    ndarray, shape (len(factors), len(factors))
+        In the squared units of the Allan variance. Beyond :data:`MAX_EXACT_LEVELS`
+        levels, the covariance relative to the model's AV, nu_j nu_k, is computed
+        at that many log-spaced factors and interpolated in log m (it is smooth there).
+
+    Examples
+    --------
+    White noise of unit variance: the lag-1 Allan variance of N samples has variance about 3 / N.
+
+    >>> cov = level_covariance([Component("WN", 1.0)], 10_000, np.array([1, 2]))
+    >>> round(float(cov[0, 0]) * 10_000, 2)
+    3.0
+    """
+    factors = np.asarray(factors, dtype=np.int64)
+    if factors.size > MAX_EXACT_LEVELS:
+        return _interpolated(components, n, factors)
+    counts = n - 2 * factors + 1
+    top = int(factors.max())
+    memory = any(c.kind in ("FN", "AR1") for c in components)
+    # a Gauss-Markov term's covariance (phi^h) squared falls below 1e-6 of its start after this many lags
+    memory_lags = max([math.ceil(7.0 / -math.log(c.shape)) for c in components if c.kind == "AR1"], default=0)
+    reach = min(int(counts.max()), (2 + 2 * TAIL) * 2 * top + memory_lags if memory else 2 * top + 2)
+    size = reach + 4 * top + 4
+    s2 = _second_sums(structure_function(components, size))
+    ramp = sum(c.scale for c in components if c.kind == "DR")
+    means = math.sqrt(ramp / 2.0) * factors.astype(np.float64)
+    out = np.empty((factors.size, factors.size))
+    for j in range(factors.size):
+        for k in range(j, factors.size):
+            out[j, k] = out[k, j] = _pair(s2, int(factors[j]), int(factors[k]), int(counts[j]),
+                                          int(counts[k]), means[j] * means[k], memory, memory_lags)
+    return out
+
+
+def _interpolated(components: Sequence[Component], n: int, factors: np.ndarray) -> np.ndarray:
+    """The covariance on a dense grid from :data:`MAX_EXACT_LEVELS` log-spaced levels.
+
+    Relative to nu_j nu_k, it is interpolated linearly in (mean, distance) of the
+    levels' log factors, where it is smooth (across the diagonal it has a kink).
+    """
+    from scipy.interpolate import LinearNDInterpolator
+
+    anchors = np.unique(np.geomspace(factors.min(), factors.max(), MAX_EXACT_LEVELS).round().astype(np.int64))
+    gaussian = [c for c in components if c.kind != "SIN"]
+
+    def model_av(m: np.ndarray) -> np.ndarray:
+        return np.sum([c.av(m) for c in gaussian], axis=0) if gaussian else np.ones(m.size)
+
+    def coordinates(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        j, k = np.triu_indices(m.size)
+        logs = np.log(m.astype(np.float64))
+        return j, k, np.column_stack([(logs[j] + logs[k]) / 2.0, logs[k] - logs[j]])
+
+    nu_anchor, nu = model_av(anchors), model_av(factors)
+    relative = level_covariance(components, n, anchors) / np.outer(nu_anchor, nu_anchor)
+    aj, ak, known = coordinates(anchors)
+    j, k, wanted = coordinates(factors)
+    values = LinearNDInterpolator(known, relative[aj, ak])(wanted)
+    out = np.empty((factors.size, factors.size))
+    out[j, k] = out[k, j] = values
+    return out * np.outer(nu, nu)
+
+
+def _phi(s2: np.ndarray, c: np.ndarray, l1: int, l2: int) -> np.ndarray:
+    """sum_{i<l1} sum_{l<l2} D(c + i - l) for integer arrays c."""
+    return _s2(s2, c + l1 + 1) - _s2(s2, c + l1 - l2 + 1) - _s2(s2, c + 1) + _s2(s2, c - l2 + 1)
+
+
+def _pair(s2: np.ndarray, mj: int, mk: int, count_j: int, count_k: int, mean2: float,
+          memory: bool, memory_lags: int) -> float:
+    """Cov(nu_hat_j, nu_hat_k) from gamma_jk(h) summed over the lags with pairs."""
+    span = 2 * (mj + mk) * (1 + TAIL) + memory_lags if memory else 2 * (mj + mk) + 2
+    low, high = max(1 - count_k, -span), min(count_j - 1, span)
+    # gamma's kinks: where an argument of S2 crosses 0; the pair count's: h = 0 and h = M_k - M_j
+    shifts = np.array([mj, -mk, mj - mk, 0])
+    ends = np.array([mj + 1, mj - mk + 1, 1, 1 - mk])
+    kinks = np.concatenate([(shifts[:, None] + ends[None, :]).ravel(), [0, count_k - count_j]])
+    h, weights = _nodes(low, high, kinks)
+    gamma = (_phi(s2, mj - h, mj, mk) + _phi(s2, -h - mk, mj, mk) - _phi(s2, mj - mk - h, mj, mk)
+             - _phi(s2, -h, mj, mk))
+    gamma /= 4.0 * mj * mk
+    pairs = (np.minimum(count_j, count_k - h) - np.maximum(1, 1 - h) + 1).astype(np.float64)
+    total = np.dot(weights * pairs, 2.0 * gamma * gamma + 4.0 * mean2 * gamma)
+    return float(total / (float(count_j) * float(count_k)))
