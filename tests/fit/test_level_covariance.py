@@ -84,7 +84,7 @@ def test_the_structure_function_gives_each_terms_allan_variance(kind, shape):
     ([Component("WN", 1.0), Component("RW", 1e-3), Component("DR", 0.05**2)], 0.05),
 ])
 def test_level_covariance_equals_the_dense_quadratic_forms(components, omega):
-    n, factors = 300, 2 ** np.arange(7)
+    n, factors = 300, np.array([1, 2, 4, 8, 16, 32, 64, 100, 149])  # the last level has M = 2 terms
     exact = brute_force(components, n, factors, omega)
     fast = level_covariance(components, n, factors)
     spread = np.sqrt(np.diag(exact))
@@ -141,7 +141,7 @@ def test_a_dense_grid_is_interpolated_from_log_spaced_levels():
                                atol=0.03)
 
 
-def test_non_overlapping_estimates_get_wider_intervals():
+def test_non_overlapping_estimates_get_wider_intervals_for_the_random_walk():
     import avar
 
     rng = np.random.default_rng(4)
@@ -149,6 +149,6 @@ def test_non_overlapping_estimates_get_wider_intervals():
     widths = {}
     for type in ("mo", "to"):
         table = avar.noise_report(x, gyro_units="rad/s", freq=100.0, type=type).table
-        row = table[table["Process"] == "WN"].iloc[0]
+        row = table[table["Process"] == "RW"].iloc[0]
         widths[type] = float(row["Upper"]) - float(row["Lower"])
     assert widths["to"] > 1.2 * widths["mo"]

@@ -218,7 +218,7 @@ def _pair(s2: np.ndarray, mj: int, mk: int, count_j: int, count_k: int, mean2: f
           memory: bool, memory_lags: int) -> float:
     """Cov(nu_hat_j, nu_hat_k) from gamma_jk(h) summed over the lags with pairs."""
     span = 2 * (mj + mk) * (1 + TAIL) + memory_lags if memory else 2 * (mj + mk) + 2
-    low, high = max(1 - count_k, -span), min(count_j - 1, span)
+    low, high = max(1 - count_j, -span), min(count_k - 1, span)  # s in 1..M_j and s + h in 1..M_k
     # gamma's kinks: where an argument of S2 crosses 0; the pair count's: h = 0 and h = M_k - M_j
     shifts = np.array([mj, -mk, mj - mk, 0])
     ends = np.array([mj + 1, mj - mk + 1, 1, 1 - mk])
@@ -227,6 +227,6 @@ def _pair(s2: np.ndarray, mj: int, mk: int, count_j: int, count_k: int, mean2: f
     gamma = (_phi(s2, mj - h, mj, mk) + _phi(s2, -h - mk, mj, mk) - _phi(s2, mj - mk - h, mj, mk)
              - _phi(s2, -h, mj, mk))
     gamma /= 4.0 * mj * mk
-    pairs = (np.minimum(count_j, count_k - h) - np.maximum(1, 1 - h) + 1).astype(np.float64)
+    pairs = np.maximum(np.minimum(count_j, count_k - h) - np.maximum(1, 1 - h) + 1, 0).astype(np.float64)
     total = np.dot(weights * pairs, 2.0 * gamma * gamma + 4.0 * mean2 * gamma)
     return float(total / (float(count_j) * float(count_k)))

@@ -21,10 +21,11 @@ import pandas as pd
 from avar._validation import as_series, check_real
 from avar.fit.gmwm import octave_factors
 from avar.fit.report.checks import FIT_SHARE, data_warnings, fit_check, unit_warnings
+from avar.fit.report.efficient import efficient_fit, non_overlapping_fit
 from avar.fit.report.noise_terms import ACCEL, GYRO, check_unit
 from avar.fit.report.result import NoiseReport
 from avar.fit.report.rows import channel_rows, minimum_row
-from avar.fit.report.sensor_fit import SensorFit, fit_sensor_model, with_level_covariance
+from avar.fit.report.sensor_fit import SensorFit, fit_sensor_model
 from avar.imu import IMU
 from avar.stability.allan import avar as allan_variance
 from avar.stability.results import AllanVariance, ImuAllanVariance
@@ -132,12 +133,14 @@ def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray,
     The fit weighs the levels by their degrees of freedom (N - 2m + 1) / m;
     the band uses Greenhall's EDF of the overlapping Allan variance at the
     noise type of the fitted model's local slope (alpha = -1 - d log AV / d log
-    tau, rounded into -2..2); the parameters' covariance, the exact covariance
-    of the levels under the selected model
-    (:func:`~avar.fit.report.sensor_fit.with_level_covariance`). When the
-    selected model fits fewer than 90 % of the levels, the selection is
-    extended by the terms the data demand (``check`` of
-    :func:`~avar.fit.report.sensor_fit.fit_sensor_model`).
+    tau, rounded into -2..2). When the selected model fits fewer than 90 % of
+    the levels, the selection is extended by the terms the data demand (``check`` of
+    :func:`~avar.fit.report.sensor_fit.fit_sensor_model`). The selected model
+    is then refitted with the exact covariance of the maximal-overlap levels
+    under it, which also gives the parameters' covariance
+    (:func:`~avar.fit.report.efficient.efficient_fit`); a non-overlapping ("to")
+    estimate keeps its maximum-likelihood fit, its levels' variances from
+    Greenhall's EDF (:func:`~avar.fit.report.efficient.non_overlapping_fit`).
     """
     factors = np.asarray(av.averaging_factors, dtype=np.int64)
     counts = np.maximum(av.n - 2 * factors + 1, 1)
@@ -151,9 +154,9 @@ def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray,
     if share(fit.implied(factors)) < FIT_SHARE:
         fit = fit_sensor_model(factors, nu_hat, counts / factors, check=share)
         lower, upper, edf = _band(av, fit.implied(factors), alpha)
-    # "to" estimates have fewer terms: Greenhall's variances, the maximal-overlap correlation
-    variances = None if av.type == "mo" else 2.0 * fit.implied(factors) ** 2 / edf
-    return with_level_covariance(fit, av.n, variances), lower, upper
+    if av.type != "mo":  # the exact covariance is the maximal-overlap estimator's
+        return non_overlapping_fit(fit, av.n, 2.0 * fit.implied(factors) ** 2 / edf), lower, upper
+    return efficient_fit(fit, av.n, check=share), lower, upper
 
 
 def _band(av: AllanVariance, implied: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -56,10 +56,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avar.fit.report.level_covariance import level_covariance
+from avar.fit.report.sandwich import independent_levels, parameter_covariance
 from avar.fit.report.sensor_terms import KINDS, LINEAR, Component, basis, deviance, weight_edf
 
-__all__ = ["SensorFit", "fit_sensor_model", "term_bound", "with_level_covariance"]
+__all__ = ["SensorFit", "fit_sensor_model", "term_bound"]
 
 #: How many of each shaped term a model may hold.
 MAX_COPIES = {"AR1": 2, "SIN": 2}
@@ -91,7 +91,8 @@ class SensorFit:
         Penalty per parameter of the criterion.
     levels : ndarray or None
         Covariance of the Allan variance estimates under the selected model
-        (:func:`with_level_covariance`); None: independent levels of ``edf`` degrees of freedom.
+        (:func:`avar.fit.report.efficient.efficient_fit`); None: independent levels of ``edf``
+        degrees of freedom.
     """
 
     components: tuple[Component, ...]
@@ -160,6 +161,8 @@ class _Problem:
         self.grids = {"AR1": np.exp(-1.0 / times),                                 # phi of correlation time 2^e
                       "SIN": np.unique(np.clip(0.37 / 2.0**exponents, None, 0.45))}  # f peaking at m = 2^e
         self.phi_range = (math.exp(-0.5), math.exp(-4.0 / max(float(factors[-1]), 8.0)))
+        # a sinusoid slower than the record is a ramp; faster than 2.2 samples, white noise
+        self.f_range = (0.37 / max(float(factors[-1]), 1.0), 0.45)
 
     def column(self, kind: str, shape: float | None) -> np.ndarray:
         key = (kind, None if shape is None else round(float(shape), 15))
@@ -209,7 +212,8 @@ class _Problem:
             for k, u in zip(shaped, free):
                 kind = terms[k][0]
                 shape = math.exp(-math.exp(-u)) if kind == "AR1" else 0.5 / (1.0 + math.exp(-u))
-                out[k] = (kind, min(max(shape, self.phi_range[0]), self.phi_range[1]) if kind == "AR1" else shape)
+                low, high = self.phi_range if kind == "AR1" else self.f_range
+                out[k] = (kind, min(max(shape, low), high))
             return out
 
         def pack(values: list[tuple[str, float | None]]) -> np.ndarray:
@@ -352,66 +356,10 @@ def fit_sensor_model(factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, *
     scales, current = problem.solve(terms)
     kept = [(t, c) for t, c in zip(terms, scales) if c > 0]
     components = tuple(Component(kind, float(c), shape) for (kind, shape), c in kept)
-    covariance = _covariance(components, factors, edf, _independent(components, factors, sampling_edf))
+    covariance = parameter_covariance(components, factors, edf, independent_levels(components, factors, sampling_edf))
     return SensorFit(components=components, covariance=covariance, factors=factors, nu_hat=nu_hat, edf=sampling_edf,
                      deviance=current, criterion=current + penalty * _size([(c.kind, c.shape) for c in components]),
                      penalty=penalty)
-
-
-def _covariance(components: tuple[Component, ...], factors: np.ndarray, edf: np.ndarray,
-                levels: np.ndarray) -> np.ndarray:
-    """Covariance of (scales, shapes): the sandwich of the fit's weights around the ``levels``' covariance.
-
-    The fit weighs level j by ``edf`` (capped by the model-discrepancy floor);
-    the estimates then vary with the covariance S of the Allan variance estimates:
-    Cov = A^-1 J' W S W J A^-1, W = diag(edf / (2 nu^2)), A = J' W J
-    (the inverse Fisher information when S = diag(2 nu^2 / edf)).
-    """
-    columns = [basis(c.kind, c.shape, factors) for c in components]
-    jacobian = list(columns)
-    for c in components:
-        if c.shape is None:
-            continue
-        step = 1e-6 * max(abs(c.shape), 1e-3) if c.kind == "SIN" else 1e-6 * (1.0 - c.shape)
-        moved = min(c.shape + step, 0.5 - 1e-12) if c.kind == "SIN" else min(c.shape + step, 1.0 - 1e-15)
-        jacobian.append(c.scale * (basis(c.kind, moved, factors) - basis(c.kind, c.shape, factors)) / (moved - c.shape))
-    if not jacobian:
-        return np.zeros((0, 0))
-    design = np.column_stack(jacobian)
-    nu = np.sum([c.scale * col for c, col in zip(components, columns)], axis=0)
-    # relative residuals and unit-norm columns: the scales span many decades (DR's m^2 / 2 against QN's 3 / m^2)
-    norms = np.linalg.norm(design / nu[:, None], axis=0)
-    norms[norms == 0] = 1.0
-    design = design / norms
-    weighted = design * (edf / (2.0 * nu**2))[:, None]
-    bread = np.linalg.pinv(design.T @ weighted)
-    return (bread @ (weighted.T @ levels @ weighted) @ bread) / np.outer(norms, norms)
-
-
-def _independent(components: tuple[Component, ...], factors: np.ndarray, edf: np.ndarray) -> np.ndarray:
-    """Covariance of independent Allan variance estimates of ``edf`` degrees of freedom: diag(2 nu^2 / edf)."""
-    nu = np.sum([c.av(factors) for c in components], axis=0) if components else np.ones(factors.size)
-    return np.diag(2.0 * nu**2 / edf)
-
-
-def with_level_covariance(fit: SensorFit, n: int, variances: np.ndarray | None = None) -> SensorFit:
-    """The same fit with its parameters' covariance from the exact covariance of the levels.
-
-    The levels' covariance is that of the selected model itself
-    (:func:`~avar.fit.report.level_covariance.level_covariance`: every term's
-    contribution at every level and the correlation between levels, for a
-    maximal-overlap estimate from ``n`` samples), so the sandwich is right where
-    terms mix. Given ``variances`` (another estimator's, e.g. the non-overlapping
-    one's from Greenhall's EDF), the levels keep that correlation with these variances.
-    """
-    import dataclasses
-
-    levels = level_covariance(fit.components, int(n), fit.factors)
-    if variances is not None:
-        scale = np.sqrt(np.asarray(variances, dtype=np.float64) / np.diag(levels))
-        levels = levels * np.outer(scale, scale)
-    covariance = _covariance(fit.components, fit.factors, weight_edf(fit.edf), levels)
-    return dataclasses.replace(fit, covariance=covariance, levels=levels)
 
 
 def term_bound(fit: SensorFit, kind: str, level: float = 0.95) -> float:
@@ -428,8 +376,8 @@ def term_bound(fit: SensorFit, kind: str, level: float = 0.95) -> float:
     scales, _ = problem.solve(terms)
     components = [Component(k, max(float(c), 0.0), s) for (k, s), c in zip(terms, scales)]
     floor = tuple(Component(c.kind, max(c.scale, 1e-300), c.shape) for c in components)
-    levels = _independent(floor, fit.factors, fit.edf) if fit.levels is None else fit.levels
-    covariance = _covariance(floor, fit.factors, weight_edf(fit.edf), levels)
+    levels = independent_levels(floor, fit.factors, fit.edf) if fit.levels is None else fit.levels
+    covariance = parameter_covariance(floor, fit.factors, weight_edf(fit.edf), levels)
     at = len(terms) - 1
     spread = math.sqrt(max(float(covariance[at, at]), 0.0))
     return components[at].scale + float(norm.ppf(level)) * spread
