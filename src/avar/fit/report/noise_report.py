@@ -21,11 +21,11 @@ import pandas as pd
 from avar._validation import as_series, check_real
 from avar.fit.gmwm import octave_factors
 from avar.fit.report.checks import FIT_SHARE, data_warnings, fit_check, unit_warnings
-from avar.fit.report.efficient import efficient_fit, non_overlapping_fit
 from avar.fit.report.noise_terms import ACCEL, GYRO, check_unit
 from avar.fit.report.result import NoiseReport
 from avar.fit.report.rows import channel_rows, minimum_row
 from avar.fit.report.sensor_fit import SensorFit, fit_sensor_model
+from avar.fit.report.uncertainty import non_overlapping_fit, with_level_covariance
 from avar.imu import IMU
 from avar.stability.allan import avar as allan_variance
 from avar.stability.results import AllanVariance, ImuAllanVariance
@@ -135,12 +135,12 @@ def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray,
     noise type of the fitted model's local slope (alpha = -1 - d log AV / d log
     tau, rounded into -2..2). When the selected model fits fewer than 90 % of
     the levels, the selection is extended by the terms the data demand (``check`` of
-    :func:`~avar.fit.report.sensor_fit.fit_sensor_model`). The selected model
-    is then refitted with the exact covariance of the maximal-overlap levels
-    under it, which also gives the parameters' covariance
-    (:func:`~avar.fit.report.efficient.efficient_fit`); a non-overlapping ("to")
-    estimate keeps its maximum-likelihood fit, its levels' variances from
-    Greenhall's EDF (:func:`~avar.fit.report.efficient.non_overlapping_fit`).
+    :func:`~avar.fit.report.sensor_fit.fit_sensor_model`). The parameters'
+    covariance is the sandwich around the exact covariance of the
+    maximal-overlap levels under the selected model
+    (:func:`~avar.fit.report.uncertainty.with_level_covariance`); for a
+    non-overlapping ("to") estimate, that correlation with Greenhall's variances
+    (:func:`~avar.fit.report.uncertainty.non_overlapping_fit`).
     """
     factors = np.asarray(av.averaging_factors, dtype=np.int64)
     counts = np.maximum(av.n - 2 * factors + 1, 1)
@@ -156,7 +156,7 @@ def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray,
         lower, upper, edf = _band(av, fit.implied(factors), alpha)
     if av.type != "mo":  # the exact covariance is the maximal-overlap estimator's
         return non_overlapping_fit(fit, av.n, 2.0 * fit.implied(factors) ** 2 / edf), lower, upper
-    return efficient_fit(fit, av.n, check=share), lower, upper
+    return with_level_covariance(fit, av.n), lower, upper
 
 
 def _band(av: AllanVariance, implied: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,8 +1,8 @@
 """The covariance of a sensor model's parameters: a sandwich of the fit's weights around the levels' covariance.
 
 Whatever weights W a fit gives the Allan variance estimates nu_hat (the
-diagonal of the maximum-likelihood fit, or the full matrix of the efficient
-step), the parameters theta vary with the estimates' covariance S as::
+diagonal of the maximum-likelihood fit, or a full matrix), the parameters
+theta vary with the estimates' covariance S as::
 
     Cov(theta) = A^-1 J' W S W J A^-1,   A = J' W J,
 

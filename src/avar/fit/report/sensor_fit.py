@@ -91,7 +91,7 @@ class SensorFit:
         Penalty per parameter of the criterion.
     levels : ndarray or None
         Covariance of the Allan variance estimates under the selected model
-        (:func:`avar.fit.report.efficient.efficient_fit`); None: independent levels of ``edf``
+        (:func:`avar.fit.report.uncertainty.with_level_covariance`); None: independent levels of ``edf``
         degrees of freedom.
     """
 
