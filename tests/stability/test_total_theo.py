@@ -110,6 +110,18 @@ def test_kernels_match_the_plain_loops_on_larger_data():
     assert total / (6 * count) == pytest.approx(float(plain_htotvar(exact(y), 6)), rel=1e-10)
 
 
+def test_threads_give_the_serial_sums(monkeypatch):
+    from avar._kernels import total
+
+    x = np.cumsum(RNG.standard_normal(3000))
+    for kind, m in ((0, 5), (1, 3), (2, 40)):  # several tasks of CHUNK terms each
+        monkeypatch.setattr(total, "PARALLEL_WORK", 1 << 60)
+        serial = total.level_sums(kind, x, np.array([m]), NO_GAPS, 0)
+        monkeypatch.setattr(total, "PARALLEL_WORK", 0)
+        threaded = total.level_sums(kind, x, np.array([m]), NO_GAPS, 0)
+        assert threaded[0][0] == serial[0][0] and threaded[1][0] == serial[1][0]
+
+
 def detrended(x: np.ndarray) -> np.ndarray:
     t = np.arange(x.size)
     return x - np.polyval(np.polyfit(t, x, 1), t)
