@@ -280,6 +280,27 @@ def test_stable32_htotdev_bounds_and_term_counts():
     assert (2.0297e-01 / 2.0247e-01) ** 2 == pytest.approx(1 / 0.995, rel=5e-4)
 
 
+# Stable32 1.60, PHASE.DAT, octave, alpha 0: AF, min, sigma, max of MTOTDEV and TTOTDEV (allantools'
+# tests/phasedat/phase_dat_{mtotdev,ttotdev}_octave.txt). Below m = 10 its bounds follow MDEV's EDF.
+STABLE32_MTOTDEV = [(1, 2.0163e-01, 2.0664e-01, 2.1204e-01), (2, 1.3898e-01, 1.4337e-01, 1.4821e-01),
+                    (4, 9.0598e-02, 9.4613e-02, 9.9218e-02), (8, 6.1866e-02, 6.5721e-02, 7.0406e-02)]
+STABLE32_TTOTDEV = [(1, 1.1641e-01, 1.1930e-01, 1.2242e-01), (2, 1.6048e-01, 1.6555e-01, 1.7114e-01),
+                    (4, 2.0923e-01, 2.1850e-01, 2.2913e-01), (8, 2.8575e-01, 3.0355e-01, 3.2519e-01)]
+
+
+@pytest.mark.parametrize("name, table", [("mtotdev", STABLE32_MTOTDEV), ("ttotdev", STABLE32_TTOTDEV)])
+def test_stable32_mtotdev_bounds_at_small_factors(name, table):
+    from pathlib import Path
+
+    x = np.loadtxt(Path(__file__).parents[1] / "data" / "stable32" / "PHASE.DAT")
+    rows = np.array(table)
+    res = getattr(avar, name)(x, data_type="phase", taus=rows[:, 0], alpha=0)
+    np.testing.assert_allclose(res.deviation, rows[:, 2], rtol=3e-5)  # Stable32 prints 5 digits
+    np.testing.assert_allclose(res.lci, rows[:, 1], rtol=6e-4)  # its MDEV EDF runs ~1.2 % above Greenhall's here
+    np.testing.assert_allclose(res.uci, rows[:, 3], rtol=6e-4)
+    assert np.all(res.edf == estimator_edf("mdev", [0] * 4, rows[:, 0].astype(int), 1001))
+
+
 def test_triangle_products_equal_their_loops():
     from avar._kernels.theo_fft import half_convolution, hankel_lower, phi_sums
 

@@ -186,7 +186,8 @@ def mtotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     adjacent m-point phase averages of x*(n): the 3m-point window x_n ..
     x_{n+3m-1} less the line through the means of its halves, extended at both
     ends by uninverted even reflection to 9m points. tau = m tau0, m = 1 .. N / 3,
-    n = N - 3m + 1 terms. Dimensionless. EDF: b N / m - c (NIST SP 1065 Table 8).
+    n = N - 3m + 1 terms. Dimensionless. EDF: the modified Allan variance's (Greenhall)
+    below m = 10, as Stable32, then b N / m - c (NIST SP 1065 Table 8).
     ``bias_correction=True`` divides by MTOTVAR / MVAR (0.94, 0.83, 0.73, 0.70,
     0.69 for alpha = 2 .. -2); Stable32 and ``allantools`` do not (default False).
     Each level costs O(N m).
