@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import avar
-from avar._kernels.theo import oavar_expanded, oavar_sums, theo1_all, theo1_ratio
+from avar._kernels.theo import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
 from avar._kernels.theo_fft import autocorrelation
 from avar._kernels.total import htot_sum, mtot_sum, theo1_sum
 from avar.stability.edf import estimator_edf
@@ -110,17 +110,39 @@ def test_kernels_match_the_plain_loops_on_larger_data():
     assert total / (6 * count) == pytest.approx(float(plain_htotvar(exact(y), 6)), rel=1e-10)
 
 
-def test_theo1_all_factors_at_once_equals_the_direct_sum():
-    for x in (RNG.standard_normal(121), np.cumsum(RNG.standard_normal(121)), np.cumsum(np.cumsum(RNG.standard_normal(121)))):
-        x = x - np.polyval(np.polyfit(np.arange(121), x, 1), np.arange(121))
-        fast = theo1_all(x, 60, np.zeros(0))
-        direct = np.array([theo1_sum(x, 2 * k, NO_GAPS, 0)[0] for k in range(1, 61)])
-        np.testing.assert_allclose(fast, direct, rtol=1e-9)
-        looked_up = theo1_all(x, 60, autocorrelation(x))
-        assert np.all(np.abs(looked_up / direct - 1) < 1e-15 * theo1_ratio(x, looked_up) * 60)
-        m = np.arange(1, 60)
-        sums, ratio = oavar_expanded(x, m, autocorrelation(x))
-        assert np.all(np.abs(sums / oavar_sums(x, m) - 1) < 1e-15 * ratio * 60)
+def test_threads_give_the_serial_sums(monkeypatch):
+    from avar._kernels import total
+
+    x = np.cumsum(RNG.standard_normal(3000))
+    for kind, m in ((0, 5), (1, 3), (2, 40)):  # several tasks of CHUNK terms each
+        monkeypatch.setattr(total, "PARALLEL_WORK", 1 << 60)
+        serial = total.level_sums(kind, x, np.array([m]), NO_GAPS, 0)
+        monkeypatch.setattr(total, "PARALLEL_WORK", 0)
+        threaded = total.level_sums(kind, x, np.array([m]), NO_GAPS, 0)
+        assert threaded[0][0] == serial[0][0] and threaded[1][0] == serial[1][0]
+
+
+def detrended(x: np.ndarray) -> np.ndarray:
+    t = np.arange(x.size)
+    return x - np.polyval(np.polyfit(t, x, 1), t)
+
+
+@pytest.mark.parametrize("n", [121, 3001])
+def test_theo1_at_every_factor_equals_the_direct_sum(n):
+    """theo1_every (FFT, half convolutions, exponential sums) against the double loop at every even m,
+    within eps times its conditioning ratio; OAVAR from the same lag diagonals."""
+    rng = np.random.default_rng(n)
+    largest = min(n - 1, 1000)
+    for x in (rng.standard_normal(n), np.cumsum(rng.standard_normal(n)), np.cumsum(np.cumsum(rng.standard_normal(n)))):
+        x = detrended(x)
+        diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), largest + 1)
+        sums, ratio = theo1_every(x, largest, autocorrelation(x), diagonals)
+        m = np.arange(2, largest + 1, 2 if n < 1000 else 38)
+        direct = np.array([theo1_sum(x, int(k), NO_GAPS, 0)[0] for k in m])
+        assert np.all(np.abs(sums[m] / direct - 1) < 1e-13 * ratio[m])
+        m = np.arange(1, min(largest, (n - 1) // 2) + 1)
+        avar_sums, avar_ratio = oavar_expanded(x, m, autocorrelation(x), diagonals)
+        assert np.all(np.abs(avar_sums / oavar_sums(x, m) - 1) < 1e-13 * avar_ratio)
 
 
 @pytest.mark.parametrize("name", ["mtotdev", "ttotdev", "htotdev", "theo1"])
@@ -258,28 +280,62 @@ def test_stable32_htotdev_bounds_and_term_counts():
     assert (2.0297e-01 / 2.0247e-01) ** 2 == pytest.approx(1 / 0.995, rel=5e-4)
 
 
+# Stable32 1.60, PHASE.DAT, octave, alpha 0: AF, min, sigma, max of MTOTDEV and TTOTDEV (allantools'
+# tests/phasedat/phase_dat_{mtotdev,ttotdev}_octave.txt). Below m = 10 its bounds follow MDEV's EDF.
+STABLE32_MTOTDEV = [(1, 2.0163e-01, 2.0664e-01, 2.1204e-01), (2, 1.3898e-01, 1.4337e-01, 1.4821e-01),
+                    (4, 9.0598e-02, 9.4613e-02, 9.9218e-02), (8, 6.1866e-02, 6.5721e-02, 7.0406e-02)]
+STABLE32_TTOTDEV = [(1, 1.1641e-01, 1.1930e-01, 1.2242e-01), (2, 1.6048e-01, 1.6555e-01, 1.7114e-01),
+                    (4, 2.0923e-01, 2.1850e-01, 2.2913e-01), (8, 2.8575e-01, 3.0355e-01, 3.2519e-01)]
+
+
+@pytest.mark.parametrize("name, table", [("mtotdev", STABLE32_MTOTDEV), ("ttotdev", STABLE32_TTOTDEV)])
+def test_stable32_mtotdev_bounds_at_small_factors(name, table):
+    from pathlib import Path
+
+    x = np.loadtxt(Path(__file__).parents[1] / "data" / "stable32" / "PHASE.DAT")
+    rows = np.array(table)
+    res = getattr(avar, name)(x, data_type="phase", taus=rows[:, 0], alpha=0)
+    np.testing.assert_allclose(res.deviation, rows[:, 2], rtol=3e-5)  # Stable32 prints 5 digits
+    np.testing.assert_allclose(res.lci, rows[:, 1], rtol=6e-4)  # its MDEV EDF runs ~1.2 % above Greenhall's here
+    np.testing.assert_allclose(res.uci, rows[:, 3], rtol=6e-4)
+    assert np.all(res.edf == estimator_edf("mdev", [0] * 4, rows[:, 0].astype(int), 1001))
+
+
+def test_triangle_products_equal_their_loops():
+    from avar._kernels.theo_fft import half_convolution, hankel_lower, phi_sums
+
+    rng = np.random.default_rng(12)
+    y, kappa, f, g = (rng.standard_normal(1400) for _ in range(4))
+    count = 700  # a few depths above the leaves
+    lower = [sum(y[i] * kappa[k + i] for i in range(k)) for k in range(count)]
+    np.testing.assert_allclose(hankel_lower(y, kappa, count), lower, atol=1e-11)
+    half = [sum(f[a] * g[k - a] for a in range(k // 2 + 1)) for k in range(count)]
+    np.testing.assert_allclose(half_convolution(f, g, count), half, atol=1e-11)
+    phi = [sum(2.0 * y[j] / (c + j) for j in range(c % 2, c, 2)) for c in range(count)]
+    np.testing.assert_allclose(phi_sums(y, count), phi, atol=1e-12)
+
+
 def test_theo1_by_fft_equals_the_direct_sum(monkeypatch):
-    from avar._kernels import theo_fft
+    from avar._kernels import theo_levels
 
     rng = np.random.default_rng(11)
     for x in (rng.standard_normal(3001), np.cumsum(rng.standard_normal(3001)),
               np.cumsum(np.cumsum(rng.standard_normal(3001)))):
-        x = x - np.polyval(np.polyfit(np.arange(3001), x, 1), np.arange(3001))
-        prepared = (np.concatenate(([0.0], np.cumsum(x * x))), theo_fft.autocorrelation(x),
-                    np.ascontiguousarray(x[::-1]))
-        for m in (2, 300, 1026, 3000):
-            total, ratio = theo_fft.theo1_expanded(x, m, *prepared)
+        x = detrended(x)
+        prepared = theo_levels.prepare(x, 1500)
+        for m in (2, 300, 1026, 2000, 3000):
+            total, ratio = theo_levels.theo1_expanded(prepared, m)
             direct = theo1_sum(x, m, NO_GAPS, 0)[0]
             assert total == pytest.approx(direct, rel=max(1e-13, 1e-14 * ratio)), (m, ratio)
-    triangle = theo_fft.triangle_sum(x, 3, 5, 700, np.arange(-800.0, 801.0), 800)
-    assert triangle == pytest.approx(sum((5 + q - 3 - p) * x[3 + p] * x[5 + q] for p in range(700)
-                                         for q in range(700 - p)), rel=1e-11)
-    monkeypatch.setattr(theo_fft, "DIRECT_TERMS", 0)  # every level by FFT, or direct where ill-conditioned
+    monkeypatch.setattr(theo_levels, "DIRECT_TERMS", 0)  # every level by FFT, or direct where ill-conditioned
     factors = np.array([2, 4, 64, 512, 2048])
-    sums, expanded = theo_fft.theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, NO_GAPS, 0)[0])
+    sums, expanded = theo_levels.theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, NO_GAPS, 0)[0])
     assert 0 < expanded < factors.size  # the random-walk-FM phase keeps its small levels direct
     np.testing.assert_allclose(sums, [theo1_sum(x, m, NO_GAPS, 0)[0] for m in factors], rtol=1e-10)
-    y = rng.standard_normal(2000)
-    slow = avar.theo1(y)
-    monkeypatch.setattr(theo_fft, "DIRECT_TERMS", 0)
-    np.testing.assert_allclose(avar.theo1(y).deviation, slow.deviation, rtol=1e-10)
+    for phase in (rng.standard_normal(2000), np.cumsum(rng.standard_normal(2000))):  # white PM, white FM
+        phase = phase * 1e-9 + 1e3 + 1e-3 * np.arange(2000)  # offset and drift 1e6 and 1e12 x the noise
+        monkeypatch.setattr(theo_levels, "DIRECT_TERMS", 1 << 40)
+        slow = avar.theo1(phase, data_type="phase", taus="all")
+        monkeypatch.setattr(theo_levels, "DIRECT_TERMS", 0)
+        np.testing.assert_allclose(avar.theo1(phase, data_type="phase", taus="all").deviation, slow.deviation,
+                                   rtol=1e-10)

@@ -11,17 +11,18 @@ the input + 1; empty when there is none) and ``shift`` is 0 for phase data
 ``x[k + 1] - x[k]`` is missing). A term whose phase points ``start .. stop - 1``
 touch a gap is skipped; the kernels return the sum and the number of terms used.
 
-Each window of the total statistics is detrended, extended by reflection and
-summed through the running sum of its 9m-point extension, so a window costs
-O(m) and a level O(N m); Theo1 costs O(N m / 2) per level. A level's terms run
-in tasks of :data:`CHUNK` terms whose sums are added in task order, so a
-parallel loop over the tasks would give the same result on any number of threads.
+Each window of the total statistics is detrended and summed through the running
+sum of its 9m-point reflected extension, read from the window's own running sum
+(one pass, no extension is built), so a window costs O(m) and a level O(N m);
+Theo1 costs O(N m / 2) per level. A level's terms run in tasks of :data:`CHUNK`
+terms whose sums are added in task order; large levels run the tasks on every
+thread (numba's ``prange``) with the same result as the serial loop.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 @njit(cache=True)
@@ -33,29 +34,10 @@ def _clean(bad: np.ndarray, shift: int, start: int, stop: int) -> bool:
 
 
 @njit(cache=True)
-def _reflected_terms(w: np.ndarray, m: int, ext: np.ndarray) -> float:
-    """sum_{j=0}^{6m-1} (A_j - 2 B_j + C_j)**2 of the 9m-point extension (rev w, w, rev w)
-    of the 3m-point window ``w``, where A_j, B_j, C_j are the sums of m consecutive
-    points of the extension starting at j, j + m, j + 2m (through its running sum ``ext``)."""
-    span = 3 * m
-    ext[0] = 0.0
-    for k in range(span):
-        ext[k + 1] = ext[k] + w[span - 1 - k]
-    for k in range(span):
-        ext[span + k + 1] = ext[span + k] + w[k]
-    for k in range(span):
-        ext[2 * span + k + 1] = ext[2 * span + k] + w[span - 1 - k]
-    acc = 0.0
-    for j in range(6 * m):
-        d = (ext[j + 3 * m] - 3.0 * ext[j + 2 * m]) + (3.0 * ext[j + m] - ext[j])
-        acc += d * d
-    return acc
-
-
-@njit(cache=True)
-def _detrended_window(values: np.ndarray, start: int, m: int, w: np.ndarray) -> None:
-    """The 3m values from ``start`` less the line through the means of their first and last
-    halves (floor(3m / 2) points each, the middle point left out when 3m is odd), centred."""
+def _detrended_running_sum(values: np.ndarray, start: int, m: int, run: np.ndarray) -> None:
+    """run[k] = sum_{i<k} w_i, k = 0 .. 3m, of the 3m values from ``start`` less the line
+    through the means of their first and last halves (floor(3m / 2) points each, the middle
+    point left out when 3m is odd), centred (run[3m] = 0 up to rounding)."""
     span = 3 * m
     half = span // 2
     gap = span - half  # distance between the two halves' centres
@@ -64,29 +46,74 @@ def _detrended_window(values: np.ndarray, start: int, m: int, w: np.ndarray) -> 
     for k in range(half):
         first += values[start + k]
         last += values[start + gap + k]
+    total = first + last + (values[start + half] if gap > half else 0.0)
     slope = (last - first) / half / gap
-    mean = 0.0
+    mean = (total - slope * (span * (span - 1) / 2.0)) / span
+    acc = 0.0
+    run[0] = 0.0
     for k in range(span):
-        w[k] = values[start + k] - slope * k
-        mean += w[k]
-    mean /= span
-    for k in range(span):
-        w[k] -= mean
-
-
-#: Terms per task: fixed, so the sums would not depend on the number of threads.
-CHUNK = 512
+        acc += (values[start + k] - mean) - slope * k
+        run[k + 1] = acc
 
 
 @njit(cache=True)
-def _window_range(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, first: int, last: int,
-                  w: np.ndarray, ext: np.ndarray) -> tuple[float, int]:
+def _sixth(a0, o0, c0, a1, o1, c1, a2, o2, c2, a3, o3, c3, constant, first, stop):
+    """sum_j (constant + sum_k c_k a_k[j + o_k])**2 over j = first .. stop - 1."""
+    acc = 0.0
+    for j in range(first, stop):
+        d = (constant + c3 * a3[j + o3] + c2 * a2[j + o2]) + (c1 * a1[j + o1] + c0 * a0[j + o0])
+        acc += d * d
+    return acc
+
+
+@njit(cache=True)
+def _part(run: np.ndarray, back: np.ndarray, span: int, part: int, shift: int) -> tuple:
+    """The array, offset and sign reading the extension's running sum at j + ``shift`` in ``part``."""
+    if part == 1:
+        return run, shift - span, 1.0
+    return back, shift - 2 * span * (part // 2), -1.0
+
+
+@njit(cache=True)
+def _reflected_terms(run: np.ndarray, back: np.ndarray, m: int) -> float:
+    """sum_{j=0}^{6m-1} (A_j - 2 B_j + C_j)**2 over the 9m-point extension (rev w, w, rev w)
+    of a 3m-point window w with running sum ``run`` (A_j, B_j, C_j: sums of m consecutive
+    points from j, j + m, j + 2m). The extension's running sum at i is read from ``run`` and
+    ``back`` (``run`` reversed): S - back[i] (i <= 3m), S + run[i - 3m] (i <= 6m), 3 S -
+    back[i - 6m], S = run[3m]. Over each sixth of the j range every index j + k m (k = 0 .. 3)
+    stays in one part, so the loop reads four arrays forward at fixed offsets:
+    A_j - 2 B_j + C_j = E(j + 3m) - 3 E(j + 2m) + 3 E(j + m) - E(j)."""
+    span = 3 * m
+    total = run[span]
+    acc = 0.0
+    for sixth in range(6):
+        p0, p1, p2, p3 = sixth // 3, (sixth + 1) // 3, (sixth + 2) // 3, (sixth + 3) // 3
+        constant = total * ((1.0 if p3 < 2 else 3.0) - 3.0 * (1.0 if p2 < 2 else 3.0)
+                            + 3.0 * (1.0 if p1 < 2 else 3.0) - (1.0 if p0 < 2 else 3.0))
+        a0, o0, s0 = _part(run, back, span, p0, 0)
+        a1, o1, s1 = _part(run, back, span, p1, m)
+        a2, o2, s2 = _part(run, back, span, p2, 2 * m)
+        a3, o3, s3 = _part(run, back, span, p3, 3 * m)
+        acc += _sixth(a0, o0, -s0, a1, o1, 3.0 * s1, a2, o2, -3.0 * s2, a3, o3, s3, constant,
+                      sixth * m, (sixth + 1) * m)
+    return acc
+
+
+#: Terms per task: fixed, so the sums do not depend on the number of threads.
+CHUNK = 512
+
+
+@njit(cache=True, nogil=True)
+def _window_range(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, first: int,
+                  last: int) -> tuple[float, int]:
     """The terms ``first .. last - 1`` of one level (``kind`` 0 MTOTDEV on phase, 1 HTOTDEV on
     frequency, 2 Theo1 on phase): their sum and how many avoid the gaps."""
     total = 0.0
     count = 0
     span = 3 * m
     half = m // 2
+    run = np.empty(span + 1)
+    back = np.empty(span + 1)
     for start in range(first, last):
         if kind == 2:
             if not _clean(bad, shift, start, start + m + 1):
@@ -99,33 +126,59 @@ def _window_range(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift:
         else:
             if not _clean(bad, shift, start, start + span + kind):
                 continue
-            _detrended_window(values, start, m, w)
-            total += _reflected_terms(w, m, ext) / (6.0 * m * m * m)
+            _detrended_running_sum(values, start, m, run)
+            for k in range(span + 1):
+                back[k] = run[span - k]
+            total += _reflected_terms(run, back, m) / (6.0 * m * m * m)
         count += 1
     return total, count
 
 
 @njit(cache=True, nogil=True)
-def _level(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, n_terms: int) -> tuple[float, int]:
-    """One level's sum over its ``n_terms`` terms, in tasks of :data:`CHUNK` summed in order.
+def _level_serial(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int,
+                  n_terms: int) -> tuple[float, int]:
+    n_tasks = (n_terms + CHUNK - 1) // CHUNK
+    total = 0.0
+    count = 0
+    for task in range(n_tasks):
+        first = task * CHUNK
+        part, used = _window_range(kind, values, m, bad, shift, first, min(n_terms, first + CHUNK))
+        total += part
+        count += used
+    return total, count
 
-    Serial: with numba's ``prange`` over the tasks the result is the same, but on two
-    shared cores it measured 1.3-1.5x slower (N = 1e4); kept ready for more cores."""
+
+@njit(cache=True, nogil=True, parallel=True)
+def _level_parallel(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int,
+                    n_terms: int) -> tuple[float, int]:
+    """:func:`_level_serial` with the tasks spread over the threads; their sums are added in
+    task order, so the result is the same on any number of threads."""
     n_tasks = (n_terms + CHUNK - 1) // CHUNK
     sums = np.zeros(n_tasks)
     counts = np.zeros(n_tasks, dtype=np.int64)
-    for task in range(n_tasks):
-        w = np.empty(3 * m)
-        ext = np.empty(9 * m + 1)
+    for task in prange(n_tasks):
         first = task * CHUNK
         sums[task], counts[task] = _window_range(kind, values, m, bad, shift, first,
-                                                 min(n_terms, first + CHUNK), w, ext)
+                                                 min(n_terms, first + CHUNK))
     total = 0.0
     count = 0
     for task in range(n_tasks):
         total += sums[task]
         count += counts[task]
     return total, count
+
+
+#: Levels with more window points than this (terms x window length) run on every thread.
+PARALLEL_WORK = 1 << 24
+
+
+def _level(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, n_terms: int) -> tuple[float, int]:
+    """One level's sum over its ``n_terms`` terms, in tasks of :data:`CHUNK` summed in order
+    (serially for small levels: threads cost more than they save there)."""
+    work = n_terms * m * (1 if kind == 2 else 3)
+    if work > PARALLEL_WORK and n_terms > CHUNK:
+        return _level_parallel(kind, values, m, bad, shift, n_terms)
+    return _level_serial(kind, values, m, bad, shift, n_terms)
 
 
 def mtot_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> tuple[float, int]:

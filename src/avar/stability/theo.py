@@ -13,8 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from avar._kernels.theo import oavar_expanded, oavar_sums, theo1_all, theo1_ratio
-from avar._kernels.theo_fft import MAX_RATIO, autocorrelation, theo1_sums
+from avar._kernels.theo import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
+from avar._kernels.theo_fft import autocorrelation
+from avar._kernels.theo_levels import MAX_RATIO, theo1_sums
 from avar._kernels.total import theo1_sum
 from avar.stability.deviation_grids import deviation_factors
 from avar.stability.deviation_results import Deviation
@@ -38,14 +39,16 @@ def theobr_factor(x: np.ndarray) -> tuple[float, int]:
     i = np.arange(n + 1, dtype=np.int64)
     m_avar = 9 + 3 * i
     m_theo = 12 + 4 * i
-    autocorr = autocorrelation(x)  # lag sums by FFT; each sum is checked and redone directly if ill-conditioned
-    avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr)
+    # lag sums by FFT; each sum is checked and redone directly if ill-conditioned
+    autocorr = autocorrelation(x)
+    diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), int(m_avar[-1]) + 1)
+    avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
     redo = avar_ratio > MAX_RATIO
     avar_sums[redo] = oavar_sums(x, m_avar[redo])
-    every = theo1_all(x, int(m_theo[-1] // 2), autocorr)
-    theo_sums = every[m_theo // 2 - 1]
+    every, ratio = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
+    theo_sums = every[m_theo]
     no_gaps = np.zeros(0, dtype=np.int64)
-    for level in np.flatnonzero(theo1_ratio(x, every)[m_theo // 2 - 1] > MAX_RATIO):
+    for level in np.flatnonzero(ratio[m_theo] > MAX_RATIO):
         theo_sums[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0]
     avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
     theo = theo_sums / (0.75 * (n_points - m_theo) * m_theo * m_theo)
@@ -88,9 +91,9 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     :func:`avar.theo1`, tau = 0.75 m tau0) from k. Each level's noise is
     identified by the OADEV rules (at 0.75 m for Theo1 levels) or fixed by
     ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. kf needs Theo1 at every m = 2 .. N / 7.5
-    (Lewis's recurrence on the FFT autocorrelation, O(N^2 / 450)) and OAVAR at N / 30
-    factors; a sum whose expansion is ill-conditioned (random-walk FM at small m) is
-    summed directly, exactly but in O(N m). ``n``: N - 2m
+    and OAVAR at N / 30 factors, all at once from FFT autocorrelations in O(N log N)
+    (:func:`avar._kernels.theo.theo1_every`); a sum whose expansion is ill-conditioned
+    (random-walk FM: most of them) is summed directly, exactly but in O(N m). ``n``: N - 2m
     (OADEV), (N - m) m / 2 (Theo1, as Stable32). Dimensionless.
 
     Parameters

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from avar._kernels.theo_fft import theo1_sums
+from avar._kernels.theo_levels import theo1_sums
 from avar._kernels.total import level_sums, theo1_sum
 from avar.stability.deviation_core import phase_parts
 from avar.stability.deviation_grids import levels_with_terms
@@ -186,7 +186,8 @@ def mtotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     adjacent m-point phase averages of x*(n): the 3m-point window x_n ..
     x_{n+3m-1} less the line through the means of its halves, extended at both
     ends by uninverted even reflection to 9m points. tau = m tau0, m = 1 .. N / 3,
-    n = N - 3m + 1 terms. Dimensionless. EDF: b N / m - c (NIST SP 1065 Table 8).
+    n = N - 3m + 1 terms. Dimensionless. EDF: the modified Allan variance's (Greenhall)
+    below m = 10, as Stable32, then b N / m - c (NIST SP 1065 Table 8).
     ``bias_correction=True`` divides by MTOTVAR / MVAR (0.94, 0.83, 0.73, 0.70,
     0.69 for alpha = 2 .. -2); Stable32 and ``allantools`` do not (default False).
     Each level costs O(N m).
@@ -282,8 +283,9 @@ def theo1(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     The noise is identified at the factor 0.75 m by the OADEV rules; EDF:
     Howe and Tasset (see :func:`avar.stability.total_edf.total_edf`). Each
     level costs O(N m / 2) directly; long levels of gap-free data are expanded into the
-    record's FFT autocorrelation and two end triangles (O(m log^2 m), see
-    :mod:`avar._kernels.theo_fft`) wherever that keeps 1e-11 relative accuracy.
+    record's FFT autocorrelation and the autocorrelations of its ends (O(m log m) per
+    level after O(N log N) shared work, see :mod:`avar._kernels.theo_levels`) wherever
+    that keeps 1e-11 relative accuracy.
     {parameters}
     References
     ----------
