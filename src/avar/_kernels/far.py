@@ -38,11 +38,12 @@ are added in a fixed order, so the bits do not depend on the number of threads.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange, types
+from numba import njit, types
 from numba.extending import overload
 
 from avar._kernels.haar import _is_wide, _pair
 from avar._kernels.streaming import _EPS, CERTIFY_TOL, _two_sum, certified
+from avar._kernels.tasks import run_tasks
 
 #: Samples per piece: the table's granularity for the large levels and the length of a local prefix.
 SWEEP_FINE = 1 << 10
@@ -132,7 +133,7 @@ def chained_squares(start, steps, count):
             d += steps[i]
         return total
     d0 = start
-    d1 = d0 + _plain_sum(steps, 0, q)
+    d1 = d0 + _plain_sum(steps, np.int64(0), q)
     d2 = d1 + _plain_sum(steps, q, 2 * q)
     d3 = d2 + _plain_sum(steps, 2 * q, 3 * q)
     d4 = d3 + _plain_sum(steps, 3 * q, 4 * q)
@@ -274,7 +275,7 @@ def difference_error_bound(errors, bigs, base_hi, base_lo, table_mag):
     return errors + 5.05 * _EPS * (abs(base_hi) + abs(base_lo) + bigs) + 8.0 * _EPS * _EPS * table_mag
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, fine, tol, out_row):
     """Adds to ``out_row`` the sums of ``D**2`` of every level over the pieces
     ``first, first + stride, ...`` (pieces of ``fine`` samples, level ``k`` its
@@ -288,7 +289,7 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
     errors = np.empty(ring)
     bigs = np.empty(ring)
     steps = np.empty(fine)
-    ready = 0  # class steps whose local prefix is in the ring
+    ready = np.int64(0)  # class steps whose local prefix is in the ring
     j = 0
     while (first + stride * j) * fine < nd[0]:
         q = first + stride * j
@@ -329,22 +330,21 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
         j += 1
 
 
-@njit(cache=True, parallel=True)
 def far_sums(rows, scale, centre, th, tl, spread, factors, nd, fine, tol=CERTIFY_TOL):
     """Sums of ``D**2`` per (column, level), shape (C, L), for ``factors`` strictly
     increasing multiples of the smallest, itself a multiple of ``fine``; ``nd`` the
     numbers of differences (all > 0). ``rows``: the input transposed (C, N);
     ``th, tl, centre, spread``: :func:`avar._kernels.streaming.block_table` at granularity ``fine``."""
     channels = rows.shape[0]
-    classes = factors[0] // fine
+    classes = int(factors[0]) // fine
     out = np.zeros((channels, classes, factors.shape[0]))
-    for task in prange(channels * classes):
-        c = task // classes
-        a = task % classes
+
+    def task(t):
+        c, a = divmod(t, classes)
         far_task(rows, c, a, classes, scale[c], centre[c], th, tl, spread, factors, nd, fine, tol, out[c, a])
-    result = np.zeros((channels, factors.shape[0]))
-    for c in range(channels):
-        for a in range(classes):
-            for k in range(factors.shape[0]):  # element by element: a row assignment would compile
-                result[c, k] += out[c, a, k]  # numba's shape-mismatch message (strings), seconds cold
+
+    run_tasks(channels * classes, task)
+    result = out[:, 0].copy()
+    for a in range(1, classes):  # in a fixed order: the bits do not depend on the threads
+        result += out[:, a]
     return result

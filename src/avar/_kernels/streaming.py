@@ -34,8 +34,10 @@ on the number of threads.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange, types
+from numba import njit, types
 from numba.extending import overload
+
+from avar._kernels.tasks import run_tasks
 
 #: Samples per block: table granularity and differences per inner step.
 BLOCK = 4096
@@ -165,7 +167,15 @@ def _table_column(bh, bl, n, block, integral, out_hi, out_lo):
 TABLE_TASK = 1 << 16
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True)
+def table_task(data, col, b0, b1, block, scale, bh, bl, low, high):
+    """Blocks ``b0 .. b1 - 1`` of column ``col``: their compensated sums and extreme values."""
+    n = data.shape[0]
+    for b in range(b0, b1):
+        bh[col, b], bl[col, b], low[col, b], high[col, b] = _block_sum(data, col, b * block, min(n, (b + 1) * block),
+                                                                       scale)
+
+
 def block_table(data, scale, integral, block=BLOCK):
     """Pass 1 over all columns: returns (table_hi, table_lo, centre, maxabs, spread).
 
@@ -176,19 +186,16 @@ def block_table(data, scale, integral, block=BLOCK):
     :mod:`avar._kernels.far`).
     """
     n, channels = data.shape
-    nb = (n + block - 1) // block
+    nb = -(-n // block)
     per_task = max(1, TABLE_TASK // block)
-    n_tasks = (nb + per_task - 1) // per_task
-    bh = np.empty((channels, nb))
-    bl = np.empty((channels, nb))
-    low = np.empty((channels, nb))
-    high = np.empty((channels, nb))
-    for task in prange(channels * n_tasks):
-        c = task // n_tasks
-        j = task % n_tasks
-        for b in range(j * per_task, min(nb, (j + 1) * per_task)):
-            bh[c, b], bl[c, b], low[c, b], high[c, b] = _block_sum(data, c, b * block, min(n, (b + 1) * block),
-                                                                   scale[c])
+    n_tasks = -(-nb // per_task)
+    bh, bl, low, high = (np.empty((channels, nb)) for _ in range(4))
+
+    def task(t):
+        c, j = divmod(t, n_tasks)
+        table_task(data, c, j * per_task, min(nb, (j + 1) * per_task), block, scale[c], bh, bl, low, high)
+
+    run_tasks(channels * n_tasks, task)
     return _finish_table(bh, bl, low, high, n, block, integral)
 
 
