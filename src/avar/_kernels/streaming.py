@@ -121,98 +121,91 @@ def _block_sum(data, col, start, stop, scale):
     return total, comp, low, high
 
 
-@njit(cache=True)
-def _table_column(bh, bl, n, block, integral, out_hi, out_lo):
-    """Exact (double-double) prefix of block sums, then centred on their mean.
-
-    An integer series gets an integer centre: every centred value, and so
-    every sum, is then an integer held exactly by the (hi, lo) pairs.
-    Returns the centre; fills ``out_hi/out_lo[k]`` with the centred ``S[k block]``.
-    """
-    nb = bh.shape[0]
-    th = np.empty(nb + 1)
-    tl = np.empty(nb + 1)
-    th[0] = 0.0
-    tl[0] = 0.0
-    h = 0.0
-    lo = 0.0
-    for k in range(nb):
-        s, e = _two_sum(h, bh[k])
-        e += lo + bl[k]
-        h, lo = _fast_two_sum(s, e)
-        th[k + 1] = h
-        tl[k + 1] = lo
-    centre = (h + lo) / n
-    if integral:
-        centre = np.round(centre)
-    # Dekker split of the centre for exact products p * centre.
-    big = centre * 134217729.0
-    c_hi = big - (big - centre)
-    c_lo = centre - c_hi
-    for k in range(nb + 1):
-        p = np.float64(min(k * block, n))
-        ph = p * centre
-        # exact error of p * centre (p < 2**53 is split the same way)
-        bp = p * 134217729.0
-        p_hi = bp - (bp - p)
-        p_lo = p - p_hi
-        pe = ((p_hi * c_hi - ph) + p_hi * c_lo + p_lo * c_hi) + p_lo * c_lo
-        s, e = _two_sum(th[k], -ph)
-        e += tl[k] - pe
-        out_hi[k], out_lo[k] = _fast_two_sum(s, e)
-    return centre
-
-
 #: Samples summed per parallel task of :func:`block_table` (whole blocks).
 TABLE_TASK = 1 << 16
 
 
 @njit(cache=True, nogil=True)
-def table_task(data, col, b0, b1, block, scale, bh, bl, low, high):
-    """Blocks ``b0 .. b1 - 1`` of column ``col``: their compensated sums and extreme values."""
+def table_task(data, col, b0, b1, block, scale, ph, pl, low, high):
+    """Blocks ``b0 .. b1 - 1`` of column ``col``: ``ph, pl[col, b]`` the double-double sum of
+    ``data * scale`` over blocks ``b0 .. b`` (each block's sum compensated), and every block's
+    least and largest value (of the high parts, for 64-bit integers)."""
     n = data.shape[0]
+    h = 0.0
+    lo = 0.0
     for b in range(b0, b1):
-        bh[col, b], bl[col, b], low[col, b], high[col, b] = _block_sum(data, col, b * block, min(n, (b + 1) * block),
-                                                                       scale)
+        total, comp, low[col, b], high[col, b] = _block_sum(data, col, b * block, min(n, (b + 1) * block), scale)
+        s, e = _two_sum(h, total)
+        e += lo + comp
+        h, lo = _fast_two_sum(s, e)
+        ph[col, b] = h
+        pl[col, b] = lo
 
 
 def block_table(data, scale, integral, block=BLOCK):
     """Pass 1 over all columns: returns (table_hi, table_lo, centre, maxabs, spread).
 
     ``table_*`` have shape (C, ceil(N / block) + 1) with the centred
-    cumulative sum of ``data * scale`` at every block boundary (and at N);
-    ``spread`` (C, ceil(N / block)) bounds ``|x * scale - centre|`` over each
-    block (rounded up: it bounds the rounding of the plain local prefix sums of
-    :mod:`avar._kernels.far`).
+    cumulative sum of ``data * scale`` at every block boundary (and at N), in
+    double-double; ``spread`` (C, ceil(N / block)) bounds ``|x * scale - centre|``
+    over each block (rounded up: it bounds the rounding of the plain local prefix
+    sums of :mod:`avar._kernels.far`). An integer series gets an integer centre:
+    every centred value, and so every sum, is then an integer held exactly.
+    The tasks sum their blocks in the kernel; the rest (a value per task, then
+    elementwise double-double arithmetic) is NumPy, with nothing to compile.
     """
     n, channels = data.shape
     nb = -(-n // block)
     per_task = max(1, TABLE_TASK // block)
     n_tasks = -(-nb // per_task)
-    bh, bl, low, high = (np.empty((channels, nb)) for _ in range(4))
+    ph, pl, low, high = (np.empty((channels, nb)) for _ in range(4))
 
     def task(t):
         c, j = divmod(t, n_tasks)
-        table_task(data, c, j * per_task, min(nb, (j + 1) * per_task), block, scale[c], bh, bl, low, high)
+        table_task(data, c, j * per_task, min(nb, (j + 1) * per_task), block, scale[c], ph, pl, low, high)
 
     run_tasks(channels * n_tasks, task)
-    return _finish_table(bh, bl, low, high, n, block, integral)
-
-
-@njit(cache=True)
-def _finish_table(bh, bl, low, high, n, block, integral):
-    channels, nb = bh.shape
-    table_hi = np.empty((channels, nb + 1))
-    table_lo = np.empty((channels, nb + 1))
-    centre = np.empty(channels)
-    maxabs = np.zeros(channels)
-    spread = np.empty((channels, nb))
-    for c in range(channels):
-        centre[c] = _table_column(bh[c], bl[c], n, block, integral, table_hi[c], table_lo[c])
-        for b in range(nb):
-            maxabs[c] = max(maxabs[c], max(-low[c, b], high[c, b]))
-            spread[c, b] = max(high[c, b] - centre[c], centre[c] - low[c, b]) * (1.0 + 2.0**-40)
+    with np.errstate(all="ignore"):  # non-finite data: NaN or inf sums, which the caller reports
+        # The tasks' sums added in order, then S at the end of every block.
+        before = np.zeros((2, channels, n_tasks))
+        for j in range(1, n_tasks):
+            last = j * per_task - 1
+            before[0, :, j], before[1, :, j] = _dd_add(before[0, :, j - 1], before[1, :, j - 1], ph[:, last],
+                                                       pl[:, last])
+        task_of = np.arange(nb) // per_task
+        table_hi, table_lo = np.zeros((channels, nb + 1)), np.zeros((channels, nb + 1))
+        table_hi[:, 1:], table_lo[:, 1:] = _dd_add(before[0][:, task_of], before[1][:, task_of], ph, pl)
+        centre = (table_hi[:, nb] + table_lo[:, nb]) / n
+        if integral:
+            centre = np.round(centre)
+        table_hi, table_lo = _less_centre(table_hi, table_lo, centre[:, None], block, n)
+        maxabs = np.max(np.maximum(-low, high), axis=1)
+        spread = np.maximum(high - centre[:, None], centre[:, None] - low) * (1.0 + 2.0**-40)
     return table_hi, table_lo, centre, maxabs, spread
+
+
+def _dd_add(ah, al, bh, bl):
+    """``(ah + al) + (bh + bl)`` as a renormalized pair (elementwise): TwoSum of the high
+    parts, then the low parts and the error added."""
+    s = ah + bh
+    bv = s - ah
+    e = ((ah - (s - bv)) + (bh - bv)) + (al + bl)
+    h = s + e
+    return h, e - (h - s)
+
+
+def _less_centre(th, tl, centre, block, n):
+    """``S[k block] - min(k block, N) * centre`` exactly (Dekker's product), as pairs."""
+    big = centre * 134217729.0  # Dekker split of the centre for exact products p * centre
+    c_hi = big - (big - centre)
+    c_lo = centre - c_hi
+    p = np.minimum(np.arange(th.shape[1]) * block, n).astype(np.float64)
+    ph = p * centre
+    bp = p * 134217729.0  # p < 2**53 is split the same way
+    p_hi = bp - (bp - p)
+    p_lo = p - p_hi
+    pe = ((p_hi * c_hi - ph) + p_hi * c_lo + p_lo * c_hi) + p_lo * c_lo  # the exact error of p * centre
+    return _dd_add(th, tl, -ph, -pe)
 
 
 @njit(cache=True)
