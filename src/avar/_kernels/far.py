@@ -92,25 +92,16 @@ def second_differences(rows, col, t0, m, count, sc, out):
     x1 = rows[col, t0 + m : t0 + m + count - 1]
     x2 = rows[col, t0 + 2 * m : t0 + 2 * m + count - 1]
     g = out[: count - 1]
-    if sc == 1.0:  # the usual case: the products fold away
-        for i in range(count - 1):
-            g[i] = _second_difference(x2[i], x1[i], x0[i], 1.0)
-    else:
-        for i in range(count - 1):
-            g[i] = _second_difference(x2[i], x1[i], x0[i], sc)
+    for i in range(count - 1):
+        g[i] = _second_difference(x2[i], x1[i], x0[i], sc)
     out[count - 1] = 0.0
 
 
-#: Independent running sums of :func:`chained_squares` (they hide the latency of the adds).
-CHAINS = 8
-
-
 @njit(cache=True, fastmath={"reassoc", "contract"})
-def _plain_sum(g, lo, hi):
+def _plain_sum(g):
     total = 0.0
-    x = g[lo:hi]
-    for i in range(hi - lo):
-        total += x[i]
+    for i in range(g.shape[0]):
+        total += g[i]
     return total
 
 
@@ -120,57 +111,26 @@ def chained_squares(start, steps, count):
 
     The running value is ``D`` itself, so each addition errs by at most ``u |D|``: the
     sum errs by at most ``2 count u`` relative, however large the samples or the
-    cumulative sum. The block runs as :data:`CHAINS` stretches whose starting values
-    come from the stretches' plain sums of steps, so the additions do not wait for one
-    another (a single running sum is bound by the latency of one add per sample).
+    cumulative sum. The block runs as two halves, the second starting from the plain sum
+    of the first half's steps, so that the two running sums do not wait for each other
+    (one is bound by the latency of an add per sample; more halves compiled slower, for
+    no gain on this rarely taken path).
     """
-    q = count // CHAINS
-    if q < 4:
-        d = start
-        total = 0.0
-        for i in range(count):
-            total += d * d
-            d += steps[i]
-        return total
-    d0 = start
-    d1 = d0 + _plain_sum(steps, np.int64(0), q)
-    d2 = d1 + _plain_sum(steps, q, 2 * q)
-    d3 = d2 + _plain_sum(steps, 2 * q, 3 * q)
-    d4 = d3 + _plain_sum(steps, 3 * q, 4 * q)
-    d5 = d4 + _plain_sum(steps, 4 * q, 5 * q)
-    d6 = d5 + _plain_sum(steps, 5 * q, 6 * q)
-    d7 = d6 + _plain_sum(steps, 6 * q, 7 * q)
-    s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = 0.0
-    g0 = steps[0:q]
+    q = count // 2
+    g0 = steps[:q]
     g1 = steps[q : 2 * q]
-    g2 = steps[2 * q : 3 * q]
-    g3 = steps[3 * q : 4 * q]
-    g4 = steps[4 * q : 5 * q]
-    g5 = steps[5 * q : 6 * q]
-    g6 = steps[6 * q : 7 * q]
-    g7 = steps[7 * q : 8 * q]
+    d0 = start
+    d1 = start + _plain_sum(g0)
+    s0 = 0.0
+    s1 = 0.0
     for i in range(q):
         s0 += d0 * d0
         d0 += g0[i]
         s1 += d1 * d1
         d1 += g1[i]
-        s2 += d2 * d2
-        d2 += g2[i]
-        s3 += d3 * d3
-        d3 += g3[i]
-        s4 += d4 * d4
-        d4 += g4[i]
-        s5 += d5 * d5
-        d5 += g5[i]
-        s6 += d6 * d6
-        d6 += g6[i]
-        s7 += d7 * d7
-        d7 += g7[i]
-    rest = steps[8 * q : count]
-    for i in range(count - 8 * q):
-        s7 += d7 * d7
-        d7 += rest[i]
-    return ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))
+    if count > 2 * q:
+        s1 += d1 * d1
+    return s0 + s1
 
 
 @njit(cache=True, inline="always")
