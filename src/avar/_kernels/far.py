@@ -80,7 +80,7 @@ def _second_difference_overload(x2, x1, x0, sc):
     return impl
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def second_differences(rows, col, t0, m, count, sc, out):
     """``out[i] = (x[t0+i+2m] - 2 x[t0+i+m] + x[t0+i]) * sc`` for ``i < count - 1``; ``out[count - 1] = 0``.
 
@@ -105,7 +105,7 @@ def _plain_sum(g):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def chained_squares(start, steps, count):
     """Sum over ``i < count`` of ``D_i**2`` where ``D_0 = start`` and ``D_{i+1} = D_i + steps[i]``.
 
@@ -141,7 +141,7 @@ def _base(th, tl, col, k0, k1, k2):
     return s, (e + e2) + ((tl[col, k2] - 2.0 * tl[col, k1]) + tl[col, k0])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def local_prefix(rows, col, start, count, centre, sc, out):
     """``out[i] = sum_{s<i} (x[start+s] sc - centre)`` in plain float64 for ``i < count``
     (and ``i = count`` when ``out`` is longer: a last, short piece is read up to its end).
@@ -164,7 +164,7 @@ def local_prefix(rows, col, start, count, centre, sc, out):
     return big
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def fill_prefixes(rows, col, first, stride, fine, centre, sc, at, out, bigs):
     """:func:`local_prefix` of the four whole pieces ``first + g stride`` (g < 4) into the ring
     rows ``(at + g) % len(out)``, and their ``B`` into ``bigs``: the same operations in the

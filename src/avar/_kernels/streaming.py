@@ -103,7 +103,7 @@ def _centred_overload(x, c, sc):
     return impl
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _block_sum(data, col, start, stop, scale):
     """Compensated sum of ``data[start:stop, col] * scale`` and its least and largest value
     (of the high parts, for 64-bit integers)."""
@@ -208,7 +208,7 @@ def _less_centre(th, tl, centre, block, n):
     return _dd_add(th, tl, -ph, -pe)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at, bounds, track=True):
     """``out[at + i] = S[start + i]`` for ``i = 0 .. stop - start`` from ``S[start] = (s_hi, s_lo)``.
 
@@ -275,7 +275,7 @@ def _fast_sum(buffer, count):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def squares(h0, l0, a0, h1, l1, a1, h2, l2, a2, count, buffer):
     """Sum over ``j < count`` of ``D_j**2`` from three windows of ``S`` (compensated differences)."""
     x0 = h0[a0 : a0 + count]
@@ -309,7 +309,7 @@ def plain_squares(h, a, m, count):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def certified(total, delta, count, tol):
     """Whether ``count`` squares summing to ``total`` are within ``tol`` (relative) of
     their exact sum when every squared value errs by at most ``delta``: the bound
@@ -319,7 +319,7 @@ def certified(total, delta, count, tol):
     return total > 0.0 and np.isfinite(total) and bound <= tol * total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def certified_squares(h, l, a, m, count, buffer, bounds):
     """:func:`squares` of one window (``S = h + l`` at offsets a, a + m, a + 2m) by the plain
     :func:`plain_squares` of ``h`` alone when its error is provably below :data:`CERTIFY_TOL`.
@@ -342,7 +342,7 @@ def certified_squares(h, l, a, m, count, buffer, bounds):
     return squares(h, l, a, h, l, a + m, h, l, a + 2 * m, count, buffer)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def window_level_sums(data, col, t0, need, centre, scale, wh, wl, w0, filled, factors, nd, count, block, out_row,
                       buffer, bounds):
     """Squared second differences of the first ``count`` levels for the block at ``t0``, from a sliding window.
