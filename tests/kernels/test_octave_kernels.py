@@ -216,7 +216,7 @@ def test_sweep_steps_and_chained_squares_match_exact_arithmetic(dtype, count):
     """The sweep's large levels: steps ``x[t+2m] - 2 x[t+m] + x[t]`` rounded once, and the sum of
     the squares of the running ``D`` they drive (started from an exact ``D_0``), against
     Fractions, on an offset far above the noise (where a prefix-sum method would cancel)."""
-    from avar._kernels.far import chained_squares, second_differences
+    from avar._kernels.far_steps import chained_squares, second_differences
 
     rng = np.random.default_rng(count)
     n, m, t0 = 3 * 4096, 1024, 37
@@ -316,7 +316,7 @@ def test_local_prefixes_err_within_their_certified_bound(name, dtype):
 
 
 def test_second_differences_scale_extreme_samples_before_rounding():
-    from avar._kernels.far import second_differences
+    from avar._kernels.far_steps import second_differences
 
     x = np.array([1e300, -1e300, 1e300, 3e300, -1e300, 2e300])[:, None]
     steps = np.empty(3)
