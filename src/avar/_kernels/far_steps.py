@@ -129,19 +129,62 @@ def exact_pieces(rows, cols, pieces, levels, first, stop, scale, th, tl, factors
 #: Marked pieces per task of :func:`exact_sums`.
 PIECES_PER_TASK = 64
 
+#: At most this many marked pieces (of samples exact in one float64) are redone in NumPy,
+#: which has nothing to compile: a few pieces fail the certificate by chance in most long
+#: series (a piece where ``D`` stays near zero), many only in a few kinds of data.
+NUMPY_PIECES = 256
+
 
 def exact_sums(rows, marked, scale, th, tl, factors, nd, fine):
     """Sums of ``D**2`` per (column, level) of the pieces ``marked`` (C, pieces, L) by
     the exact steps, added in the order of the pieces (the bits do not depend on the threads)."""
     cols, pieces, levels = np.nonzero(marked)
-    sums = np.empty(cols.shape[0])
-    n_tasks = -(-cols.shape[0] // PIECES_PER_TASK)
+    if cols.shape[0] <= NUMPY_PIECES and (rows.dtype.itemsize < 8 or rows.dtype == np.float64):
+        sums = numpy_pieces(rows, cols, pieces, levels, scale, th, tl, factors, nd, fine)
+    else:
+        sums = np.empty(cols.shape[0])
+        n_tasks = -(-cols.shape[0] // PIECES_PER_TASK)
 
-    def task(t):
-        exact_pieces(rows, cols, pieces, levels, t * PIECES_PER_TASK, min(cols.shape[0], (t + 1) * PIECES_PER_TASK),
-                     scale, th, tl, factors, nd, fine, sums)
+        def task(t):
+            exact_pieces(rows, cols, pieces, levels, t * PIECES_PER_TASK,
+                         min(cols.shape[0], (t + 1) * PIECES_PER_TASK), scale, th, tl, factors, nd, fine, sums)
 
-    run_tasks(n_tasks, task)
+        run_tasks(n_tasks, task)
     out = np.zeros((marked.shape[0], marked.shape[2]))
     np.add.at(out, (cols, levels), sums)  # one by one, in index order
     return out
+
+
+def _two_sums(a, b):
+    """TwoSum, elementwise: ``a + b`` and its rounding error."""
+    s = a + b
+    bv = s - a
+    return s, (a - (s - bv)) + (b - bv)
+
+
+def numpy_pieces(rows, cols, pieces, levels, scale, th, tl, factors, nd, fine):
+    """:func:`exact_pieces` of every given piece at once, in NumPy (samples exact in one float64).
+
+    The same steps, each rounded once, and the same double-double start; the running ``D``
+    is a cumulative sum started from it (each addition errs by at most ``u |D|``).
+    """
+    m = factors[levels][:, None]
+    t0 = (pieces * fine)[:, None]
+    count = np.minimum(fine, nd[levels] - pieces * fine)[:, None]
+    i = np.arange(fine)[None, :]
+    step = i < count - 1  # the steps between the piece's differences
+    at = np.where(step, t0 + i, 0)
+    c = cols[:, None]
+    sc = scale[cols][:, None]
+    with np.errstate(all="ignore"):
+        x0, x1, x2 = (rows[c, np.where(step, at + k * m, 0)].astype(np.float64) * sc for k in range(3))
+        a, ea = _two_sums(x2, x0)
+        b, eb = _two_sums(a, -2.0 * x1)
+        g = np.where(step, b + (ea + eb), 0.0)
+        o = (m // fine)[:, 0]
+        q = pieces
+        s, e = _two_sums(th[cols, q + 2 * o], -2.0 * th[cols, q + o])
+        s, e2 = _two_sums(s, th[cols, q])
+        start = s + ((e + e2) + ((tl[cols, q + 2 * o] - 2.0 * tl[cols, q + o]) + tl[cols, q]))
+        d = np.cumsum(np.concatenate([start[:, None], g[:, :-1]], axis=1), axis=1)  # D_0 .. D_{fine-1}
+        return np.sum(np.where(i < count, d * d, 0.0), axis=1)
