@@ -89,7 +89,7 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
     by the cache-blocked sweep (:mod:`avar._kernels.sweep`), the others by residue class
     (:mod:`avar._kernels.far`, table granularity ``fine``, certification tolerance ``tol``),
     in groups whose largest factor is at most ``span`` times their smallest (a task's ring
-    of local prefixes holds ``2 span + 5`` pieces: 8 MB by default, whatever N)."""
+    of local prefixes holds ``2 span + 2`` pieces: 8 MB by default, whatever N)."""
     n_small = int(np.searchsorted(factors, near))
     fine = min(fine, int(factors[n_small])) if n_small < factors.shape[0] else fine
     th, tl, centre, scale, spread = _table(data, fine)
