@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from avar._kernels.streaming import fill_prefix, point, squares, window_level_sums
+from avar._kernels.streaming import fill_running, point, squares, window_level_sums
 from avar._kernels.tasks import run_tasks
 
 
@@ -41,7 +41,6 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
     re_ = np.full(2, -2, dtype=np.int64)
     buffer = np.empty(block)
     bounds = np.zeros(2)  # largest |S| hi and lo parts the window has held
-    unused = np.zeros(2)  # the regions' magnitudes, not needed
     idx = np.empty(2, dtype=np.int64)
     w0 = kb0 * block
     filled = np.int64(0)  # not the literal 0: window_level_sums compiles once
@@ -67,8 +66,8 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
                 if where == -2:
                     where = 0 if used != 0 else 1
                     q = p // block
-                    fill_prefix(data, col, q * block, p + cnt - 1, centre, scale, th[col, q], tl[col, q],
-                                rh[where], rl[where], np.int64(0), unused, False)
+                    fill_running(data, col, q * block, p + cnt - 1, centre, scale, th[col, q], tl[col, q],
+                                 rh[where], rl[where], 0)
                     rs[where] = q * block
                     re_[where] = p + cnt - 1
                 if where >= 0:
@@ -110,13 +109,12 @@ def to_task(data, col, kb0, kb1, centre, scale, th, tl, factors, clusters, out_r
             have[k] = 2
     bh = np.empty(block + 1)
     bl = np.empty(block + 1)
-    unused = np.zeros(2)  # fill_prefix's magnitudes: not tracked here
     for kb in range(kb0, kb1):
         t0 = kb * block
         if t0 >= last_pos:
             break
         stop = min(n, t0 + block, last_pos)
-        fill_prefix(data, col, t0, stop, centre, scale, th[col, kb], tl[col, kb], bh, bl, np.int64(0), unused, False)
+        fill_running(data, col, t0, stop, centre, scale, th[col, kb], tl[col, kb], bh, bl, 0)
         for k in range(n_levels):
             m = factors[k]
             e = (t0 // m + 1) * m

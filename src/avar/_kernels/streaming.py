@@ -209,15 +209,13 @@ def _less_centre(th, tl, centre, block, n):
 
 
 @njit(cache=True, inline="always")
-def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at, bounds, track=True):
+def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at, bounds):
     """``out[at + i] = S[start + i]`` for ``i = 0 .. stop - start`` from ``S[start] = (s_hi, s_lo)``.
 
     Stored renormalized (``out_hi`` is ``S`` rounded to float64, ``out_lo`` the
     rest), so that :func:`certified_squares` can use ``out_hi`` alone; ``bounds``
-    is raised to the largest ``|out_hi|`` and ``|out_lo|`` written (see :func:`magnitudes`).
-    With ``track=False`` (prefixes that only :func:`squares` reads) the pair is
-    stored as the running sum and its compensation, not renormalized, and
-    ``bounds`` is left alone: two operations less per sample.
+    is raised to the largest ``|out_hi|`` and ``|out_lo|`` written. (Prefixes that
+    only :func:`squares` reads need neither: :func:`fill_running`.)
 
     (Loops run over slices with ``range(count)``: non-negative indices, so
     numba emits no wraparound checks and LLVM can vectorize the loads.)
@@ -230,14 +228,6 @@ def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_l
     comp = s_lo
     out_hi[at] = total
     out_lo[at] = comp
-    if not track:
-        for i in range(count):
-            yh, yl = _centred(x[i], centre, scale)
-            total, e = _two_sum(total, yh)
-            comp += e + yl
-            oh[i] = total
-            ol[i] = comp
-        return
     big_h = max(bounds[0], abs(total))
     big_l = max(bounds[1], abs(comp))
     for i in range(count):
@@ -251,6 +241,27 @@ def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_l
         big_l = max(big_l, abs(l))
     bounds[0] = big_h
     bounds[1] = big_l
+
+
+@njit(cache=True, inline="always")
+def fill_running(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at):
+    """:func:`fill_prefix` stored as the running sum and its compensation, not
+    renormalized, and no magnitudes kept: two operations less per sample, for
+    prefixes that only :func:`squares` reads."""
+    count = stop - start
+    x = data[start:stop, col]
+    oh = out_hi[at + 1 : at + 1 + count]
+    ol = out_lo[at + 1 : at + 1 + count]
+    total = s_hi
+    comp = s_lo
+    out_hi[at] = total
+    out_lo[at] = comp
+    for i in range(count):
+        yh, yl = _centred(x[i], centre, scale)
+        total, e = _two_sum(total, yh)
+        comp += e + yl
+        oh[i] = total
+        ol[i] = comp
 
 
 @njit(cache=True)
