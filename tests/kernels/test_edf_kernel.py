@@ -67,3 +67,24 @@ def test_basic_sums_equal_the_numpy_twin(d, modified):
     expected = plain_basic_sum(j, big_m, s, f, alpha, d) / (plain_sz(np.zeros(40), f, alpha, d) ** 2 * denominator)
     np.testing.assert_allclose(out, expected, rtol=1e-9)  # large powers cancel: the order of the sums shows at ~1e-12
     assert sz(0.0, 1.0, 0, d) == pytest.approx(float(plain_sz(np.zeros(1), np.ones(1), np.zeros(1, int), d)[0]))
+
+
+@pytest.mark.parametrize("d", [1, 2, 3])
+def test_greenhall_sums_in_numpy_equal_the_compiled_ones(d):
+    """Few rows take NumPy's sums, many the compiled loops: the same values either way."""
+    from avar._kernels.edf import NUMPY_ROWS, greenhall_sums
+
+    rng = np.random.default_rng(10 + d)
+    rows = NUMPY_ROWS
+    alpha = rng.integers(max(-3, 2 - 2 * d), 3, size=rows)
+    m = rng.integers(1, 60, size=rows).astype(np.float64)
+    j = np.minimum(m * (d + 1), 100.0)
+    big_m = j + rng.integers(0, 50, size=rows)
+    f = np.where(rng.random(rows) < 0.5, m, np.inf)
+    norm = np.where(rng.random(rows) < 0.2, 2.0, np.nan)
+    args = (j, big_m, m.copy(), f, alpha, d, norm, big_m.copy())
+    compiled = np.empty(rows)
+    basic_sums(*args, compiled)
+    np.testing.assert_allclose(greenhall_sums(*args), compiled, rtol=1e-9)
+    many = [np.concatenate([a, a]) if isinstance(a, np.ndarray) else a for a in args]
+    np.testing.assert_array_equal(greenhall_sums(*many), np.concatenate([compiled, compiled]))

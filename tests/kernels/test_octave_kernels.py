@@ -216,7 +216,7 @@ def test_sweep_steps_and_chained_squares_match_exact_arithmetic(dtype, count):
     """The sweep's large levels: steps ``x[t+2m] - 2 x[t+m] + x[t]`` rounded once, and the sum of
     the squares of the running ``D`` they drive (started from an exact ``D_0``), against
     Fractions, on an offset far above the noise (where a prefix-sum method would cancel)."""
-    from avar._kernels.far import chained_squares, second_differences
+    from avar._kernels.far_steps import chained_squares, second_differences
 
     rng = np.random.default_rng(count)
     n, m, t0 = 3 * 4096, 1024, 37
@@ -316,7 +316,7 @@ def test_local_prefixes_err_within_their_certified_bound(name, dtype):
 
 
 def test_second_differences_scale_extreme_samples_before_rounding():
-    from avar._kernels.far import second_differences
+    from avar._kernels.far_steps import second_differences
 
     x = np.array([1e300, -1e300, 1e300, 3e300, -1e300, 2e300])[:, None]
     steps = np.empty(3)
@@ -343,3 +343,26 @@ def test_block_magnitude_is_the_largest_magnitude_or_nan(dtype):
                 y = x.copy()
                 y[position] = bad
                 assert np.isnan(block_magnitude(y, 1.0)), (bad, position)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32, np.int16])
+@pytest.mark.parametrize("name", ["white", "random walk", "periodic"])
+def test_exact_pieces_in_numpy_equal_the_compiled_ones(name, dtype):
+    """A few marked far pieces are redone in NumPy (nothing to compile), many by the kernel:
+    both take the same once-rounded steps from the same start, on pieces cut at the end too."""
+    from avar._kernels.far_steps import exact_pieces, numpy_pieces
+
+    n, fine = 5000, 16
+    rng = np.random.default_rng(2)
+    base = {"white": rng.standard_normal(n), "random walk": np.cumsum(rng.standard_normal(n)),
+            "periodic": 1e3 * np.sin(2 * np.pi * np.arange(n) / 64) + 1e-6 * rng.standard_normal(n)}[name]
+    x = np.round(base * 100).astype(dtype) if dtype == np.int16 else base.astype(dtype)
+    data = columns._as_kernel_input(x)
+    th, tl, _, scale, _ = columns._table(data, fine)
+    factors = np.array([256, 512, 1024], dtype=np.int64)
+    nd = n - 2 * factors + 1
+    cols, pieces, levels = np.nonzero(np.arange(-(-nd[0] // fine))[None, :, None] * fine < nd[None, None, :])
+    want = np.empty(cols.size)
+    exact_pieces(data.T, cols, pieces, levels, 0, cols.size, scale, th, tl, factors, nd, fine, want)
+    got = numpy_pieces(data.T, cols, pieces, levels, scale, th, tl, factors, nd, fine)
+    np.testing.assert_allclose(got, want, rtol=1e-13, atol=0)

@@ -2,11 +2,7 @@
 
 from __future__ import annotations
 
-import math
-
-import numba
 import numpy as np
-from numba import njit
 
 from avar._kernels.far import FAR_SPAN, SWEEP_FINE, far_sums
 from avar._kernels.haar import CHUNK_BLOCKS as HAAR_CHUNK
@@ -28,30 +24,21 @@ SMALL_MAX = 1 << 15
 SMALL_MO_MAX = 1 << 18
 
 
-@njit(cache=True)
 def _scales(maxabs):
-    """Power-of-two scale per column bringing extreme magnitudes near 1 (1.0 otherwise)."""
-    scale = np.ones(maxabs.shape[0])
-    redo = False
-    for c in range(maxabs.shape[0]):
-        v = maxabs[c]
-        if np.isfinite(v) and v > 0.0 and (v > 2.0**LIMIT_EXP or v < 2.0**-LIMIT_EXP):
-            _, e = math.frexp(v)
-            e = min(max(e, -1000), 1000)  # 2**-e stays a normal float64
-            scale[c] = math.ldexp(1.0, -e)
-            redo = True
-    return scale, redo
+    """Power-of-two scale per column bringing extreme magnitudes near 1 (1.0 otherwise), and
+    whether any column has one. (NumPy: a handful of values, nothing to compile.)"""
+    with np.errstate(invalid="ignore"):
+        extreme = np.isfinite(maxabs) & (maxabs > 0.0) & ((maxabs > 2.0**LIMIT_EXP) | (maxabs < 2.0**-LIMIT_EXP))
+    _, e = np.frexp(np.where(extreme, maxabs, 1.0))
+    scale = np.where(extreme, np.ldexp(1.0, -np.clip(e, -1000, 1000)), 1.0)  # 2**-e stays a normal float64
+    return scale, bool(extreme.any())
 
 
-@njit(cache=True)
 def _finish(sums, scale, factors, n_diff):
-    out = np.empty_like(sums)
-    for c in range(sums.shape[0]):
-        unscale = 1.0 / scale[c]
-        for k in range(sums.shape[1]):
-            m = np.float64(factors[k])
-            out[c, k] = sums[c, k] / (2.0 * m * m * n_diff[k]) * unscale * unscale
-    return out
+    """The Allan variances from the sums of squares of every (column, level)."""
+    m = factors.astype(np.float64)
+    unscale = (1.0 / scale)[:, None]
+    return sums / (2.0 * m * m * n_diff) * unscale * unscale
 
 
 def _table(data, block):
@@ -102,7 +89,7 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
     by the cache-blocked sweep (:mod:`avar._kernels.sweep`), the others by residue class
     (:mod:`avar._kernels.far`, table granularity ``fine``, certification tolerance ``tol``),
     in groups whose largest factor is at most ``span`` times their smallest (a task's ring
-    of local prefixes holds ``2 span + 5`` pieces: 8 MB by default, whatever N)."""
+    of local prefixes holds ``2 span + 2`` pieces: 8 MB by default, whatever N)."""
     n_small = int(np.searchsorted(factors, near))
     fine = min(fine, int(factors[n_small])) if n_small < factors.shape[0] else fine
     th, tl, centre, scale, spread = _table(data, fine)
@@ -120,16 +107,22 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
 
 
 def _as_kernel_input(data) -> np.ndarray:
+    """``data`` as an (N, C) array of a dtype the kernels read, always read-only (a view,
+    never a copy, when it is one already): writable and read-only arrays are distinct
+    types to numba, and each would compile the kernels again."""
     x = np.asarray(data)  # an np.memmap becomes a plain view, never a copy
     if x.ndim == 1:
         x = x[:, None]
     kind = x.dtype.kind
     if kind == "b":
-        return x.view(np.uint8)
-    if kind not in "iuf" or not x.dtype.isnative or x.dtype.itemsize > 8:
-        return x.astype(np.float64)
-    if x.dtype == np.float16:
-        return x.astype(np.float32)  # exact; numba has no float16 arithmetic
+        x = x.view(np.uint8)
+    elif kind not in "iuf" or not x.dtype.isnative or x.dtype.itemsize > 8:
+        x = x.astype(np.float64)
+    elif x.dtype == np.float16:
+        x = x.astype(np.float32)  # exact; numba has no float16 arithmetic
+    if x.flags.writeable:
+        x = x.view()
+        x.flags.writeable = False
     return x
 
 
@@ -162,12 +155,9 @@ def allan_variance_columns(data, factors, type: str) -> np.ndarray:
     elif is_mo and n <= SMALL_MO_MAX:
         values = small_allan_variance_parallel(x, fs, nd, is_mo, x.dtype.kind in "iu")
     else:
-        # Tasks are handed out one at a time (not in one contiguous range per thread):
-        # a thread slowed down by another process then holds back no other thread.
-        with numba.parallel_chunksize(1):
-            if np.all((fs & (fs - 1)) == 0):  # powers of two (octave grids)
-                values = run_sweep(x, fs, nd) if is_mo else run_haar(x, fs, nd)
-            else:
-                values = run_levels(x, fs, nd, is_mo)
+        if np.all((fs & (fs - 1)) == 0):  # powers of two (octave grids)
+            values = run_sweep(x, fs, nd) if is_mo else run_haar(x, fs, nd)
+        else:
+            values = run_levels(x, fs, nd, is_mo)
     out[:, valid] = values[:, inverse.reshape(-1)]
     return out

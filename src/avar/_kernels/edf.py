@@ -1,8 +1,10 @@
-"""Greenhall's BasicSum of the EDF of finite-difference variances (numba).
+"""Greenhall's BasicSum of the EDF of finite-difference variances (numba, NumPy for few rows).
 
 The loops of :func:`avar.stability.edf.greenhall_edf` (Greenhall and Riley
-2003, eqs. 7-10), one level per row, over at most J_max + 1 lags each. The
-plain twin is the NumPy transcription in the tests (and
+2003, eqs. 7-10), one level per row, over at most J_max + 1 lags each.
+:func:`greenhall_sums` takes them in NumPy for a few rows (nothing to compile:
+a noise report's levels) and compiled for many (every tau of a long series).
+The plain twin is the NumPy transcription in the tests (and
 ``allantools.edf_greenhall``, which they compare).
 """
 
@@ -78,3 +80,47 @@ def basic_sums(j, m, s, f, alpha, d, norm, denominator, out):
             total += weight * value * value
         scale = norm[i] if not np.isnan(norm[i]) else sz(0.0, f[i], alpha[i], d)
         out[i] = total / (scale * scale * denominator[i])
+
+
+#: Up to this many rows :func:`greenhall_sums` takes NumPy's sums (nothing to compile;
+#: a noise report's levels); more rows (every tau of a long series) the compiled loops.
+NUMPY_ROWS = 256
+
+
+def _numpy_sw(t, alpha):
+    """:func:`_sw` elementwise."""
+    a = np.abs(t)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log = np.where(a > 0.0, np.log(np.where(a > 0.0, a, 1.0)), 0.0)
+    return np.select([alpha == 2, alpha == 1, alpha == 0, alpha == -1, alpha == -2, alpha == -3],
+                     [-a, t**2 * log, a**3, -(t**4) * log, -(a**5), t**6 * log], a**7)
+
+
+def _numpy_sz(t, f, alpha, d):
+    """:func:`sz` elementwise (the same terms in the same order)."""
+    finite = np.isfinite(f)
+    h = np.where(finite, 1.0 / np.where(finite, f, 1.0), 0.0)
+    ff = np.where(finite, f, 0.0)
+    total = np.zeros(np.broadcast(t, f, alpha).shape)
+    for k in range(-d, d + 1):
+        s = t + k
+        sx = np.where(finite, ff * ff * (2.0 * _numpy_sw(s, alpha) - _numpy_sw(s - h, alpha) - _numpy_sw(s + h, alpha)),
+                      _numpy_sw(s, alpha + 2))
+        total += (1.0 if k % 2 == 0 else -1.0) * _BINOMIAL[d, d + k] * sx
+    return total
+
+
+def greenhall_sums(j, m, s, f, alpha, d, norm, denominator):
+    """:func:`basic_sums` of every row, returned: in NumPy for at most :data:`NUMPY_ROWS`
+    rows (at most J_max + 1 lags each), else by the compiled loops."""
+    if j.shape[0] > NUMPY_ROWS:
+        out = np.empty(j.shape[0])
+        basic_sums(j, m, s, f, alpha, d, norm, denominator, out)
+        return out
+    lags = np.arange(int(np.floor(j.max())) + 1, dtype=np.float64)[None, :]
+    jj, mm = j[:, None], m[:, None]
+    weights = np.where(lags == 0, 1.0, np.where(lags < jj, 2.0 * (1.0 - lags / mm),
+                                                np.where(lags == jj, 1.0 - jj / mm, 0.0)))
+    value = _numpy_sz(lags / s[:, None], f[:, None], alpha[:, None], d)
+    scale = np.where(np.isnan(norm), _numpy_sz(np.zeros(j.shape[0]), f, alpha, d), norm)
+    return np.sum(weights * value * value, axis=1) / (scale * scale * denominator)

@@ -20,167 +20,42 @@ from the centre; ``B`` the largest ``|L|``). That bounds the error of every
 ``D`` of a piece (:func:`difference_error_bound`), and so of its sum of
 squares (:func:`avar._kernels.streaming.certified`, 1e-11 relative). A piece
 that fails (a ``D`` tiny against its samples' excursion: a component periodic
-in ``m`` far above the noise, say) is redone with its steps
-``x[t+2m] - 2 x[t+m] + x[t]`` each rounded once (:func:`second_differences`,
-TwoSum) driving the running ``D`` (:func:`chained_squares`): each addition
-then errs by at most ``u |D|``, whatever the offset or the excursion of ``S``.
-64-bit integers (not exact in one float64) always take that path.
+in ``m`` far above the noise, say) is marked, and redone after the pass with its
+steps ``x[t+2m] - 2 x[t+m] + x[t]`` each rounded once driving the running ``D``
+(:mod:`avar._kernels.far_steps`, compiled only when a piece is marked): each
+addition then errs by at most ``u |D|``, whatever the offset or the excursion of
+``S``. 64-bit integers (not exact in one float64) always take that path.
 
 Order of work: a level reads the pieces at ``t``, ``t + m`` and ``t + 2m``. All
 large ``m`` are multiples of the smallest, ``P``, so those pieces are in the
 same residue class modulo ``P``. A task takes one class (every ``P / F``-th
 piece), keeps the local prefixes of the pieces its levels still read in a ring,
 and, piece by piece, runs every level: each prefix is computed once and read
-about twice per level while it is still in the cache. The sums of the tasks
+about twice per level while it is still in the cache. (Filling four prefixes at once,
+interleaved, was 15 % faster on the prefixes, 3 % on a whole call, and took a
+quarter of far_task's compilation.) The sums of the tasks
 are added in a fixed order, so the bits do not depend on the number of threads.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange, types
-from numba.extending import overload
+from numba import njit
 
-from avar._kernels.haar import _is_wide, _pair
-from avar._kernels.streaming import _EPS, CERTIFY_TOL, _two_sum, certified
+from avar._kernels.far_steps import _base, exact_sums
+from avar._kernels.haar import _is_wide
+from avar._kernels.streaming import _EPS, CERTIFY_TOL, certified
+from avar._kernels.tasks import run_tasks
 
 #: Samples per piece: the table's granularity for the large levels and the length of a local prefix.
 SWEEP_FINE = 1 << 10
 
 #: Largest ratio of the largest to the smallest factor of one :func:`far_sums` call: a task's
-#: ring then holds at most ``2 FAR_SPAN + 5`` local prefixes (8 MB), however long the series.
+#: ring then holds at most ``2 FAR_SPAN + 2`` local prefixes (8 MB), however long the series.
 FAR_SPAN = 1 << 9
 
 
-def _second_difference(x2, x1, x0, sc):  # pragma: no cover - replaced by the overload in compiled code
-    raise NotImplementedError
-
-
-@overload(_second_difference, inline="always")
-def _second_difference_overload(x2, x1, x0, sc):
-    """``(x2 - 2 x1 + x0) * sc`` rounded once (TwoSum; 64-bit integers enter as two exact halves)."""
-    if isinstance(x2, types.Integer) and x2.bitwidth == 64:
-
-        def impl(x2, x1, x0, sc):
-            h2, l2 = _pair(x2, sc)
-            h1, l1 = _pair(x1, sc)
-            h0, l0 = _pair(x0, sc)
-            a, ea = _two_sum(h2, h0)
-            b, eb = _two_sum(a, -2.0 * h1)
-            return b + ((ea + eb) + ((l2 + l0) - 2.0 * l1))
-
-        return impl
-
-    def impl(x2, x1, x0, sc):
-        a, ea = _two_sum(np.float64(x2) * sc, np.float64(x0) * sc)
-        b, eb = _two_sum(a, -2.0 * (np.float64(x1) * sc))
-        return b + (ea + eb)
-
-    return impl
-
-
-@njit(cache=True)
-def second_differences(rows, col, t0, m, count, sc, out):
-    """``out[i] = (x[t0+i+2m] - 2 x[t0+i+m] + x[t0+i]) * sc`` for ``i < count - 1``; ``out[count - 1] = 0``.
-
-    These are the steps ``D_{t+1} - D_t`` of the level-``m`` differences (the centre
-    cancels). Each is rounded once, so it errs by at most ``u |step|`` (u = 2**-53)
-    plus ``u**2`` of the samples' magnitude. Elementwise: LLVM vectorizes it.
-    """
-    x0 = rows[col, t0 : t0 + count - 1]
-    x1 = rows[col, t0 + m : t0 + m + count - 1]
-    x2 = rows[col, t0 + 2 * m : t0 + 2 * m + count - 1]
-    g = out[: count - 1]
-    if sc == 1.0:  # the usual case: the products fold away
-        for i in range(count - 1):
-            g[i] = _second_difference(x2[i], x1[i], x0[i], 1.0)
-    else:
-        for i in range(count - 1):
-            g[i] = _second_difference(x2[i], x1[i], x0[i], sc)
-    out[count - 1] = 0.0
-
-
-#: Independent running sums of :func:`chained_squares` (they hide the latency of the adds).
-CHAINS = 8
-
-
-@njit(cache=True, fastmath={"reassoc", "contract"})
-def _plain_sum(g, lo, hi):
-    total = 0.0
-    x = g[lo:hi]
-    for i in range(hi - lo):
-        total += x[i]
-    return total
-
-
-@njit(cache=True)
-def chained_squares(start, steps, count):
-    """Sum over ``i < count`` of ``D_i**2`` where ``D_0 = start`` and ``D_{i+1} = D_i + steps[i]``.
-
-    The running value is ``D`` itself, so each addition errs by at most ``u |D|``: the
-    sum errs by at most ``2 count u`` relative, however large the samples or the
-    cumulative sum. The block runs as :data:`CHAINS` stretches whose starting values
-    come from the stretches' plain sums of steps, so the additions do not wait for one
-    another (a single running sum is bound by the latency of one add per sample).
-    """
-    q = count // CHAINS
-    if q < 4:
-        d = start
-        total = 0.0
-        for i in range(count):
-            total += d * d
-            d += steps[i]
-        return total
-    d0 = start
-    d1 = d0 + _plain_sum(steps, 0, q)
-    d2 = d1 + _plain_sum(steps, q, 2 * q)
-    d3 = d2 + _plain_sum(steps, 2 * q, 3 * q)
-    d4 = d3 + _plain_sum(steps, 3 * q, 4 * q)
-    d5 = d4 + _plain_sum(steps, 4 * q, 5 * q)
-    d6 = d5 + _plain_sum(steps, 5 * q, 6 * q)
-    d7 = d6 + _plain_sum(steps, 6 * q, 7 * q)
-    s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = 0.0
-    g0 = steps[0:q]
-    g1 = steps[q : 2 * q]
-    g2 = steps[2 * q : 3 * q]
-    g3 = steps[3 * q : 4 * q]
-    g4 = steps[4 * q : 5 * q]
-    g5 = steps[5 * q : 6 * q]
-    g6 = steps[6 * q : 7 * q]
-    g7 = steps[7 * q : 8 * q]
-    for i in range(q):
-        s0 += d0 * d0
-        d0 += g0[i]
-        s1 += d1 * d1
-        d1 += g1[i]
-        s2 += d2 * d2
-        d2 += g2[i]
-        s3 += d3 * d3
-        d3 += g3[i]
-        s4 += d4 * d4
-        d4 += g4[i]
-        s5 += d5 * d5
-        d5 += g5[i]
-        s6 += d6 * d6
-        d6 += g6[i]
-        s7 += d7 * d7
-        d7 += g7[i]
-    rest = steps[8 * q : count]
-    for i in range(count - 8 * q):
-        s7 += d7 * d7
-        d7 += rest[i]
-    return ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))
-
-
 @njit(cache=True, inline="always")
-def _base(th, tl, col, k0, k1, k2):
-    """``S[k2 F] - 2 S[k1 F] + S[k0 F]`` from the table (granularity ``F``), as a double-double."""
-    s, e = _two_sum(th[col, k2], -2.0 * th[col, k1])
-    s, e2 = _two_sum(s, th[col, k0])
-    return s, (e + e2) + ((tl[col, k2] - 2.0 * tl[col, k1]) + tl[col, k0])
-
-
-@njit(cache=True)
 def local_prefix(rows, col, start, count, centre, sc, out):
     """``out[i] = sum_{s<i} (x[start+s] sc - centre)`` in plain float64 for ``i < count``
     (and ``i = count`` when ``out`` is longer: a last, short piece is read up to its end).
@@ -201,42 +76,6 @@ def local_prefix(rows, col, start, count, centre, sc, out):
     if count < out.shape[0]:
         out[count] = total
     return big
-
-
-@njit(cache=True)
-def fill_prefixes(rows, col, first, stride, fine, centre, sc, at, out, bigs):
-    """:func:`local_prefix` of the four whole pieces ``first + g stride`` (g < 4) into the ring
-    rows ``(at + g) % len(out)``, and their ``B`` into ``bigs``: the same operations in the
-    same order per piece, interleaved so that the four running sums do not wait on one another."""
-    ring = out.shape[0]
-    a0 = first * fine
-    x0 = rows[col, a0 : a0 + fine]
-    x1 = rows[col, a0 + stride * fine : a0 + stride * fine + fine]
-    x2 = rows[col, a0 + 2 * stride * fine : a0 + 2 * stride * fine + fine]
-    x3 = rows[col, a0 + 3 * stride * fine : a0 + 3 * stride * fine + fine]
-    o0 = out[at % ring]
-    o1 = out[(at + 1) % ring]
-    o2 = out[(at + 2) % ring]
-    o3 = out[(at + 3) % ring]
-    t0 = t1 = t2 = t3 = 0.0
-    b0 = b1 = b2 = b3 = 0.0
-    for i in range(fine):
-        o0[i] = t0
-        o1[i] = t1
-        o2[i] = t2
-        o3[i] = t3
-        t0 += np.float64(x0[i]) * sc - centre
-        t1 += np.float64(x1[i]) * sc - centre
-        t2 += np.float64(x2[i]) * sc - centre
-        t3 += np.float64(x3[i]) * sc - centre
-        b0 = max(b0, abs(t0))
-        b1 = max(b1, abs(t1))
-        b2 = max(b2, abs(t2))
-        b3 = max(b3, abs(t3))
-    bigs[at % ring] = b0
-    bigs[(at + 1) % ring] = b1
-    bigs[(at + 2) % ring] = b2
-    bigs[(at + 3) % ring] = b3
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})
@@ -274,20 +113,21 @@ def difference_error_bound(errors, bigs, base_hi, base_lo, table_mag):
     return errors + 5.05 * _EPS * (abs(base_hi) + abs(base_lo) + bigs) + 8.0 * _EPS * _EPS * table_mag
 
 
-@njit(cache=True)
-def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, fine, tol, out_row):
+@njit(cache=True, nogil=True)
+def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, fine, tol, out_row, marked):
     """Adds to ``out_row`` the sums of ``D**2`` of every level over the pieces
     ``first, first + stride, ...`` (pieces of ``fine`` samples, level ``k`` its
-    differences ``0 .. nd[k] - 1``). ``spread[col, q]`` bounds ``|x sc - centre|`` over piece ``q``."""
+    differences ``0 .. nd[k] - 1``) whose certificate holds, and sets ``marked[q, k]``
+    for the others (:mod:`avar._kernels.far_steps` redoes them exactly).
+    ``spread[col, q]`` bounds ``|x sc - centre|`` over piece ``q``."""
     n = rows.shape[1]
     n_levels = factors.shape[0]
     reach = 2 * (factors[n_levels - 1] // factors[0])  # farthest piece a level reads, in class steps
-    ring = reach + 5  # the pieces a level reads, and up to three more filled ahead
-    wide = _is_wide(rows[col, 0])  # 64-bit integers: every step exact from the start
+    ring = reach + 2  # the pieces a level reads, and the one filled ahead
+    wide = _is_wide(rows[col, 0])  # 64-bit integers: every piece exact, by its steps
     prefixes = np.empty((0 if wide else ring, fine))
     errors = np.empty(ring)
     bigs = np.empty(ring)
-    steps = np.empty(fine)
     ready = 0  # class steps whose local prefix is in the ring
     j = 0
     while (first + stride * j) * fine < nd[0]:
@@ -295,13 +135,6 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
         t0 = q * fine
         while not wide and ready <= j + reach and (first + stride * ready) * fine < n:
             p = first + stride * ready
-            if (p + 3 * stride + 1) * fine <= n:  # four whole pieces, their sums interleaved
-                fill_prefixes(rows, col, p, stride, fine, centre, sc, ready, prefixes, bigs)
-                for g in range(4):
-                    slot = (ready + g) % ring
-                    errors[slot] = prefix_error_bound(fine, spread[col, p + g * stride], bigs[slot])
-                ready += 4
-                continue
             count = min(fine, n - p * fine)
             slot = ready % ring
             bigs[slot] = local_prefix(rows, col, p * fine, count, centre, sc, prefixes[slot])
@@ -311,40 +144,45 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
             cnt = min(fine, nd[k] - t0)
             if cnt <= 0:
                 break  # larger levels have fewer differences
-            m = factors[k]
-            o = m // fine
+            if wide:
+                marked[q, k] = True
+                continue
+            o = factors[k] // fine
             ch, cl = _base(th, tl, col, q, q + o, q + 2 * o)
-            if not wide:
-                h = o // stride
-                s0, s1, s2 = j % ring, (j + h) % ring, (j + 2 * h) % ring
-                total = prefix_squares(prefixes[s0], prefixes[s1], prefixes[s2], ch, cl, cnt)
-                table_mag = abs(th[col, q]) + 2.0 * abs(th[col, q + o]) + abs(th[col, q + 2 * o])
-                delta = difference_error_bound(errors[s0] + 2.0 * errors[s1] + errors[s2],
-                                               bigs[s0] + 2.0 * bigs[s1] + bigs[s2], ch, cl, table_mag)
-                if certified(total, delta, cnt, tol):
-                    out_row[k] += total
-                    continue
-            second_differences(rows, col, t0, m, cnt, sc, steps)
-            out_row[k] += chained_squares(ch + cl, steps, cnt)
+            h = o // stride
+            s0, s1, s2 = j % ring, (j + h) % ring, (j + 2 * h) % ring
+            total = prefix_squares(prefixes[s0], prefixes[s1], prefixes[s2], ch, cl, cnt)
+            table_mag = abs(th[col, q]) + 2.0 * abs(th[col, q + o]) + abs(th[col, q + 2 * o])
+            delta = difference_error_bound(errors[s0] + 2.0 * errors[s1] + errors[s2],
+                                           bigs[s0] + 2.0 * bigs[s1] + bigs[s2], ch, cl, table_mag)
+            if certified(total, delta, cnt, tol):
+                out_row[k] += total
+            else:
+                marked[q, k] = True
         j += 1
 
 
-@njit(cache=True, parallel=True)
 def far_sums(rows, scale, centre, th, tl, spread, factors, nd, fine, tol=CERTIFY_TOL):
     """Sums of ``D**2`` per (column, level), shape (C, L), for ``factors`` strictly
     increasing multiples of the smallest, itself a multiple of ``fine``; ``nd`` the
     numbers of differences (all > 0). ``rows``: the input transposed (C, N);
-    ``th, tl, centre, spread``: :func:`avar._kernels.streaming.block_table` at granularity ``fine``."""
+    ``th, tl, centre, spread``: :func:`avar._kernels.streaming.block_table` at granularity ``fine``.
+    The pieces that fail their certificate are redone by :mod:`avar._kernels.far_steps`
+    (compiled only then: most series have none)."""
     channels = rows.shape[0]
-    classes = factors[0] // fine
+    classes = int(factors[0]) // fine
     out = np.zeros((channels, classes, factors.shape[0]))
-    for task in prange(channels * classes):
-        c = task // classes
-        a = task % classes
-        far_task(rows, c, a, classes, scale[c], centre[c], th, tl, spread, factors, nd, fine, tol, out[c, a])
-    result = np.zeros((channels, factors.shape[0]))
-    for c in range(channels):
-        for a in range(classes):
-            for k in range(factors.shape[0]):  # element by element: a row assignment would compile
-                result[c, k] += out[c, a, k]  # numba's shape-mismatch message (strings), seconds cold
+    marked = np.zeros((channels, -(-int(nd[0]) // fine), factors.shape[0]), dtype=np.bool_)
+
+    def task(t):
+        c, a = divmod(t, classes)
+        far_task(rows, c, a, classes, scale[c], centre[c], th, tl, spread, factors, nd, fine, tol, out[c, a],
+                 marked[c])
+
+    run_tasks(channels * classes, task)
+    result = out[:, 0].copy()
+    for a in range(1, classes):  # in a fixed order: the bits do not depend on the threads
+        result += out[:, a]
+    if marked.any():
+        result += exact_sums(rows, marked, scale, th, tl, factors, nd, fine)
     return result

@@ -26,10 +26,11 @@ of threads.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange, types
+from numba import njit, types
 from numba.extending import overload
 
 from avar._kernels.streaming import _fast_sum, _two_sum
+from avar._kernels.tasks import run_tasks
 
 #: log2 of the samples per block.
 PYRAMID_EXP = 12
@@ -199,7 +200,7 @@ def _block(rows, col, start, count, sc, h, l, buffer, levels, first_h, first_l, 
     return magnitude
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _task(rows, col, kb0, kb1, sc, levels, block, sums, first_h, first_l, last_h, last_l, have, bh, bl):
     n = rows.shape[1]
     h = np.empty(block)
@@ -217,16 +218,6 @@ def _task(rows, col, kb0, kb1, sc, levels, block, sums, first_h, first_l, last_h
             bh[kb] = h[0]
             bl[kb] = l[0]
     return big if finite else np.nan
-
-
-@njit(cache=True, parallel=True)
-def _tasks_parallel(rows, sc, levels, block, chunk, n_tasks, n_blocks, sums, fh, fl, lh, ll, have, bh, bl, big):
-    channels = rows.shape[0]
-    for task in prange(channels * n_tasks):
-        c = task // n_tasks
-        j = task % n_tasks
-        big[c, j] = _task(rows, c, j * chunk, min(n_blocks, (j + 1) * chunk), sc[c], levels, block,
-                          sums[c, j], fh[c, j], fl[c, j], lh[c, j], ll[c, j], have[c, j], bh[c], bl[c])
 
 
 @njit(cache=True)
@@ -278,6 +269,13 @@ def haar_sums(data, scale, n_levels, exp=PYRAMID_EXP, chunk=CHUNK_BLOCKS):
     have = np.zeros(shape, dtype=np.bool_)
     bh, bl = np.zeros((channels, n_blocks)), np.zeros((channels, n_blocks))
     big = np.zeros((channels, n_tasks))
-    _tasks_parallel(data.T, scale, levels, block, chunk, n_tasks, n_blocks, sums, fh, fl, lh, ll, have, bh, bl, big)
+    rows = data.T
+
+    def task(t):
+        c, j = divmod(t, n_tasks)
+        big[c, j] = _task(rows, c, j * chunk, min(n_blocks, (j + 1) * chunk), scale[c], levels, block, sums[c, j],
+                          fh[c, j], fl[c, j], lh[c, j], ll[c, j], have[c, j], bh[c], bl[c])
+
+    run_tasks(channels * n_tasks, task)
     out = _combine(sums, fh, fl, lh, ll, have, bh, bl, n // block, levels, n_levels)
     return out, big.max(axis=1)

@@ -10,9 +10,10 @@ the block and chunk sizes alone.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from avar._kernels.streaming import fill_prefix, point, squares, window_level_sums
+from avar._kernels.streaming import fill_running, point, squares, window_level_sums
+from avar._kernels.tasks import run_tasks
 
 
 @njit(cache=True)
@@ -26,7 +27,7 @@ def _region(p, last, w0, w_end, rs, re_):
     return -2
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count, out_row, block, near):
     """Maximal-overlap sums of the differences starting in blocks ``kb0 .. kb1 - 1`` of one column."""
     n = data.shape[0]
@@ -40,10 +41,9 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
     re_ = np.full(2, -2, dtype=np.int64)
     buffer = np.empty(block)
     bounds = np.zeros(2)  # largest |S| hi and lo parts the window has held
-    unused = np.zeros(2)  # the regions' magnitudes, not needed
     idx = np.empty(2, dtype=np.int64)
     w0 = kb0 * block
-    filled = 0
+    filled = np.int64(0)  # not the literal 0: window_level_sums compiles once
     nh[0] = th[col, kb0]
     nl[0] = tl[col, kb0]
     for kb in range(kb0, kb1):
@@ -66,8 +66,8 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
                 if where == -2:
                     where = 0 if used != 0 else 1
                     q = p // block
-                    fill_prefix(data, col, q * block, p + cnt - 1, centre, scale, th[col, q], tl[col, q],
-                                rh[where], rl[where], 0, unused, False)
+                    fill_running(data, col, q * block, p + cnt - 1, centre, scale, th[col, q], tl[col, q],
+                                 rh[where], rl[where], 0)
                     rs[where] = q * block
                     re_[where] = p + cnt - 1
                 if where >= 0:
@@ -84,7 +84,7 @@ def mo_task(data, col, kb0, kb1, centre, scale, th, tl, factors, nd, small_count
             out_row[k] += squares(nh, nl, a, h1, l1, a1, h2, l2, a2, cnt, buffer)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def to_task(data, col, kb0, kb1, centre, scale, th, tl, factors, clusters, out_row, block):
     """Tau-overlap sums of the cluster boundaries in blocks ``kb0 .. kb1 - 1`` (positions (kb0 B, kb1 B])."""
     n = data.shape[0]
@@ -109,13 +109,12 @@ def to_task(data, col, kb0, kb1, centre, scale, th, tl, factors, clusters, out_r
             have[k] = 2
     bh = np.empty(block + 1)
     bl = np.empty(block + 1)
-    unused = np.zeros(2)  # fill_prefix's magnitudes: not tracked here
     for kb in range(kb0, kb1):
         t0 = kb * block
         if t0 >= last_pos:
             break
         stop = min(n, t0 + block, last_pos)
-        fill_prefix(data, col, t0, stop, centre, scale, th[col, kb], tl[col, kb], bh, bl, 0, unused, False)
+        fill_running(data, col, t0, stop, centre, scale, th[col, kb], tl[col, kb], bh, bl, 0)
         for k in range(n_levels):
             m = factors[k]
             e = (t0 // m + 1) * m
@@ -136,13 +135,6 @@ def to_task(data, col, kb0, kb1, centre, scale, th, tl, factors, clusters, out_r
             out_row[k] += total
 
 
-@njit(cache=True)
-def _n_chunks(count, block, chunk_blocks):
-    n_blocks = (count + block - 1) // block
-    return n_blocks, max(1, (n_blocks + chunk_blocks - 1) // chunk_blocks)
-
-
-@njit(cache=True, parallel=True)
 def level_sums(data, centre, scale, th, tl, factors, counts, is_mo, small_count, block, near, chunk_blocks):
     """Sums of ``D**2`` per (column, level), shape (C, L); ``factors`` increasing, all counts > 0.
 
@@ -150,20 +142,22 @@ def level_sums(data, centre, scale, th, tl, factors, counts, is_mo, small_count,
     clusters floor(N / m).
     """
     channels = data.shape[1]
-    span = counts[0] if is_mo else data.shape[0]
-    n_blocks, n_chunks = _n_chunks(span, block, chunk_blocks)
+    span = int(counts[0]) if is_mo else data.shape[0]
+    n_blocks = -(-span // block)
+    n_chunks = max(1, -(-n_blocks // chunk_blocks))
     out = np.zeros((channels, n_chunks, factors.shape[0]))
-    for task in prange(channels * n_chunks):
-        c = task // n_chunks
-        j = task % n_chunks
+
+    def task(t):
+        c, j = divmod(t, n_chunks)
         kb1 = min(n_blocks, (j + 1) * chunk_blocks)
         if is_mo:
             mo_task(data, c, j * chunk_blocks, kb1, centre[c], scale[c], th, tl, factors, counts, small_count,
                     out[c, j], block, near)
         else:
             to_task(data, c, j * chunk_blocks, kb1, centre[c], scale[c], th, tl, factors, counts, out[c, j], block)
-    result = np.zeros((channels, factors.shape[0]))
-    for c in range(channels):
-        for j in range(n_chunks):
-            result[c] += out[c, j]
+
+    run_tasks(channels * n_chunks, task)
+    result = out[:, 0].copy()
+    for j in range(1, n_chunks):  # in a fixed order: the bits do not depend on the threads
+        result += out[:, j]
     return result

@@ -20,9 +20,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from avar._kernels.streaming import LIMIT_EXP, certified_squares, fill_prefix
+from avar._kernels.tasks import run_tasks
 
 
 @njit(cache=True)
@@ -61,7 +62,8 @@ def _prepare(data, c, integral, hi, lo, bounds):
     if integral:
         centre = np.round(centre)
     bounds[:] = 0.0
-    fill_prefix(data, c, 0, n, centre, scale, 0.0, 0.0, hi, lo, 0, bounds)
+    zero = np.int64(0)  # not the literal 0: fill_prefix compiles once
+    fill_prefix(data, c, zero, n, centre, scale, 0.0, 0.0, hi, lo, zero, bounds)
     return scale
 
 
@@ -69,7 +71,7 @@ def _prepare(data, c, integral, hi, lo, bounds):
 def _level(hi, lo, m, count, is_mo, bounds, buffer):
     """Sum of the ``count`` squared second differences of level ``m``."""
     if is_mo:
-        return certified_squares(hi, lo, 0, m, count, buffer, bounds)
+        return certified_squares(hi, lo, np.int64(0), m, count, buffer, bounds)
     total = 0.0
     for j in range(count):
         b = j * m
@@ -102,22 +104,28 @@ def small_allan_variance(data, factors, counts, is_mo, integral):
     return out
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True)
+def _level_task(hi, lo, factors, counts, k, is_mo, bounds, unscale, out_row):
+    """Level ``k`` of one column whose cumulative sum is in ``hi/lo`` (a task of the threads)."""
+    buffer = np.empty(0)  # certified_squares allocates one if it needs it
+    mf = np.float64(factors[k])
+    sums = _level(hi, lo, factors[k], counts[k], is_mo, bounds, buffer)
+    out_row[k] = sums / (2.0 * mf * mf * counts[k]) * unscale * unscale
+
+
 def small_allan_variance_parallel(data, factors, counts, is_mo, integral):
     """:func:`small_allan_variance` with the levels shared among the threads (each level's
     sum is one thread's: the bits do not depend on the thread count)."""
     n, channels = data.shape
-    n_levels = factors.shape[0]
-    out = np.empty((channels, n_levels))
+    out = np.empty((channels, factors.shape[0]))
     hi = np.empty(n + 1)
     lo = np.empty(n + 1)
     bounds = np.zeros(2)
     for c in range(channels):
-        scale = _prepare(data, c, integral, hi, lo, bounds)
-        unscale = 1.0 / scale
-        for k in prange(n_levels):
-            buffer = np.empty(0)  # certified_squares allocates one if it needs it
-            mf = np.float64(factors[k])
-            sums = _level(hi, lo, factors[k], counts[k], is_mo, bounds, buffer)
-            out[c, k] = sums / (2.0 * mf * mf * counts[k]) * unscale * unscale
+        unscale = 1.0 / _prepare(data, c, integral, hi, lo, bounds)
+
+        def task(k, unscale=unscale, row=out[c]):
+            _level_task(hi, lo, factors, counts, k, is_mo, bounds, unscale, row)
+
+        run_tasks(factors.shape[0], task)
     return out

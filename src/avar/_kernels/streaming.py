@@ -34,8 +34,10 @@ on the number of threads.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange, types
+from numba import njit, types
 from numba.extending import overload
+
+from avar._kernels.tasks import run_tasks
 
 #: Samples per block: table granularity and differences per inner step.
 BLOCK = 4096
@@ -101,7 +103,7 @@ def _centred_overload(x, c, sc):
     return impl
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _block_sum(data, col, start, stop, scale):
     """Compensated sum of ``data[start:stop, col] * scale`` and its least and largest value
     (of the high parts, for 64-bit integers)."""
@@ -119,105 +121,101 @@ def _block_sum(data, col, start, stop, scale):
     return total, comp, low, high
 
 
-@njit(cache=True)
-def _table_column(bh, bl, n, block, integral, out_hi, out_lo):
-    """Exact (double-double) prefix of block sums, then centred on their mean.
-
-    An integer series gets an integer centre: every centred value, and so
-    every sum, is then an integer held exactly by the (hi, lo) pairs.
-    Returns the centre; fills ``out_hi/out_lo[k]`` with the centred ``S[k block]``.
-    """
-    nb = bh.shape[0]
-    th = np.empty(nb + 1)
-    tl = np.empty(nb + 1)
-    th[0] = 0.0
-    tl[0] = 0.0
-    h = 0.0
-    lo = 0.0
-    for k in range(nb):
-        s, e = _two_sum(h, bh[k])
-        e += lo + bl[k]
-        h, lo = _fast_two_sum(s, e)
-        th[k + 1] = h
-        tl[k + 1] = lo
-    centre = (h + lo) / n
-    if integral:
-        centre = np.round(centre)
-    # Dekker split of the centre for exact products p * centre.
-    big = centre * 134217729.0
-    c_hi = big - (big - centre)
-    c_lo = centre - c_hi
-    for k in range(nb + 1):
-        p = np.float64(min(k * block, n))
-        ph = p * centre
-        # exact error of p * centre (p < 2**53 is split the same way)
-        bp = p * 134217729.0
-        p_hi = bp - (bp - p)
-        p_lo = p - p_hi
-        pe = ((p_hi * c_hi - ph) + p_hi * c_lo + p_lo * c_hi) + p_lo * c_lo
-        s, e = _two_sum(th[k], -ph)
-        e += tl[k] - pe
-        out_hi[k], out_lo[k] = _fast_two_sum(s, e)
-    return centre
-
-
 #: Samples summed per parallel task of :func:`block_table` (whole blocks).
 TABLE_TASK = 1 << 16
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True)
+def table_task(data, col, b0, b1, block, scale, ph, pl, low, high):
+    """Blocks ``b0 .. b1 - 1`` of column ``col``: ``ph, pl[col, b]`` the double-double sum of
+    ``data * scale`` over blocks ``b0 .. b`` (each block's sum compensated), and every block's
+    least and largest value (of the high parts, for 64-bit integers)."""
+    n = data.shape[0]
+    h = 0.0
+    lo = 0.0
+    for b in range(b0, b1):
+        total, comp, low[col, b], high[col, b] = _block_sum(data, col, b * block, min(n, (b + 1) * block), scale)
+        s, e = _two_sum(h, total)
+        e += lo + comp
+        h, lo = _fast_two_sum(s, e)
+        ph[col, b] = h
+        pl[col, b] = lo
+
+
 def block_table(data, scale, integral, block=BLOCK):
     """Pass 1 over all columns: returns (table_hi, table_lo, centre, maxabs, spread).
 
     ``table_*`` have shape (C, ceil(N / block) + 1) with the centred
-    cumulative sum of ``data * scale`` at every block boundary (and at N);
-    ``spread`` (C, ceil(N / block)) bounds ``|x * scale - centre|`` over each
-    block (rounded up: it bounds the rounding of the plain local prefix sums of
-    :mod:`avar._kernels.far`).
+    cumulative sum of ``data * scale`` at every block boundary (and at N), in
+    double-double; ``spread`` (C, ceil(N / block)) bounds ``|x * scale - centre|``
+    over each block (rounded up: it bounds the rounding of the plain local prefix
+    sums of :mod:`avar._kernels.far`). An integer series gets an integer centre:
+    every centred value, and so every sum, is then an integer held exactly.
+    The tasks sum their blocks in the kernel; the rest (a value per task, then
+    elementwise double-double arithmetic) is NumPy, with nothing to compile.
     """
     n, channels = data.shape
-    nb = (n + block - 1) // block
+    nb = -(-n // block)
     per_task = max(1, TABLE_TASK // block)
-    n_tasks = (nb + per_task - 1) // per_task
-    bh = np.empty((channels, nb))
-    bl = np.empty((channels, nb))
-    low = np.empty((channels, nb))
-    high = np.empty((channels, nb))
-    for task in prange(channels * n_tasks):
-        c = task // n_tasks
-        j = task % n_tasks
-        for b in range(j * per_task, min(nb, (j + 1) * per_task)):
-            bh[c, b], bl[c, b], low[c, b], high[c, b] = _block_sum(data, c, b * block, min(n, (b + 1) * block),
-                                                                   scale[c])
-    return _finish_table(bh, bl, low, high, n, block, integral)
+    n_tasks = -(-nb // per_task)
+    ph, pl, low, high = (np.empty((channels, nb)) for _ in range(4))
 
+    def task(t):
+        c, j = divmod(t, n_tasks)
+        table_task(data, c, j * per_task, min(nb, (j + 1) * per_task), block, scale[c], ph, pl, low, high)
 
-@njit(cache=True)
-def _finish_table(bh, bl, low, high, n, block, integral):
-    channels, nb = bh.shape
-    table_hi = np.empty((channels, nb + 1))
-    table_lo = np.empty((channels, nb + 1))
-    centre = np.empty(channels)
-    maxabs = np.zeros(channels)
-    spread = np.empty((channels, nb))
-    for c in range(channels):
-        centre[c] = _table_column(bh[c], bl[c], n, block, integral, table_hi[c], table_lo[c])
-        for b in range(nb):
-            maxabs[c] = max(maxabs[c], max(-low[c, b], high[c, b]))
-            spread[c, b] = max(high[c, b] - centre[c], centre[c] - low[c, b]) * (1.0 + 2.0**-40)
+    run_tasks(channels * n_tasks, task)
+    with np.errstate(all="ignore"):  # non-finite data: NaN or inf sums, which the caller reports
+        # The tasks' sums added in order, then S at the end of every block.
+        before = np.zeros((2, channels, n_tasks))
+        for j in range(1, n_tasks):
+            last = j * per_task - 1
+            before[0, :, j], before[1, :, j] = _dd_add(before[0, :, j - 1], before[1, :, j - 1], ph[:, last],
+                                                       pl[:, last])
+        task_of = np.arange(nb) // per_task
+        table_hi, table_lo = np.zeros((channels, nb + 1)), np.zeros((channels, nb + 1))
+        table_hi[:, 1:], table_lo[:, 1:] = _dd_add(before[0][:, task_of], before[1][:, task_of], ph, pl)
+        centre = (table_hi[:, nb] + table_lo[:, nb]) / n
+        if integral:
+            centre = np.round(centre)
+        table_hi, table_lo = _less_centre(table_hi, table_lo, centre[:, None], block, n)
+        maxabs = np.max(np.maximum(-low, high), axis=1)
+        spread = np.maximum(high - centre[:, None], centre[:, None] - low) * (1.0 + 2.0**-40)
     return table_hi, table_lo, centre, maxabs, spread
 
 
-@njit(cache=True)
-def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at, bounds, track=True):
+def _dd_add(ah, al, bh, bl):
+    """``(ah + al) + (bh + bl)`` as a renormalized pair (elementwise): TwoSum of the high
+    parts, then the low parts and the error added."""
+    s = ah + bh
+    bv = s - ah
+    e = ((ah - (s - bv)) + (bh - bv)) + (al + bl)
+    h = s + e
+    return h, e - (h - s)
+
+
+def _less_centre(th, tl, centre, block, n):
+    """``S[k block] - min(k block, N) * centre`` exactly (Dekker's product), as pairs."""
+    big = centre * 134217729.0  # Dekker split of the centre for exact products p * centre
+    c_hi = big - (big - centre)
+    c_lo = centre - c_hi
+    p = np.minimum(np.arange(th.shape[1]) * block, n).astype(np.float64)
+    ph = p * centre
+    bp = p * 134217729.0  # p < 2**53 is split the same way
+    p_hi = bp - (bp - p)
+    p_lo = p - p_hi
+    pe = ((p_hi * c_hi - ph) + p_hi * c_lo + p_lo * c_hi) + p_lo * c_lo  # the exact error of p * centre
+    return _dd_add(th, tl, -ph, -pe)
+
+
+@njit(cache=True, inline="always")
+def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at, bounds):
     """``out[at + i] = S[start + i]`` for ``i = 0 .. stop - start`` from ``S[start] = (s_hi, s_lo)``.
 
     Stored renormalized (``out_hi`` is ``S`` rounded to float64, ``out_lo`` the
     rest), so that :func:`certified_squares` can use ``out_hi`` alone; ``bounds``
-    is raised to the largest ``|out_hi|`` and ``|out_lo|`` written (see :func:`magnitudes`).
-    With ``track=False`` (prefixes that only :func:`squares` reads) the pair is
-    stored as the running sum and its compensation, not renormalized, and
-    ``bounds`` is left alone: two operations less per sample.
+    is raised to the largest ``|out_hi|`` and ``|out_lo|`` written. (Prefixes that
+    only :func:`squares` reads need neither: :func:`fill_running`.)
 
     (Loops run over slices with ``range(count)``: non-negative indices, so
     numba emits no wraparound checks and LLVM can vectorize the loads.)
@@ -230,14 +228,6 @@ def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_l
     comp = s_lo
     out_hi[at] = total
     out_lo[at] = comp
-    if not track:
-        for i in range(count):
-            yh, yl = _centred(x[i], centre, scale)
-            total, e = _two_sum(total, yh)
-            comp += e + yl
-            oh[i] = total
-            ol[i] = comp
-        return
     big_h = max(bounds[0], abs(total))
     big_l = max(bounds[1], abs(comp))
     for i in range(count):
@@ -251,6 +241,27 @@ def fill_prefix(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_l
         big_l = max(big_l, abs(l))
     bounds[0] = big_h
     bounds[1] = big_l
+
+
+@njit(cache=True, inline="always")
+def fill_running(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_lo, at):
+    """:func:`fill_prefix` stored as the running sum and its compensation, not
+    renormalized, and no magnitudes kept: two operations less per sample, for
+    prefixes that only :func:`squares` reads."""
+    count = stop - start
+    x = data[start:stop, col]
+    oh = out_hi[at + 1 : at + 1 + count]
+    ol = out_lo[at + 1 : at + 1 + count]
+    total = s_hi
+    comp = s_lo
+    out_hi[at] = total
+    out_lo[at] = comp
+    for i in range(count):
+        yh, yl = _centred(x[i], centre, scale)
+        total, e = _two_sum(total, yh)
+        comp += e + yl
+        oh[i] = total
+        ol[i] = comp
 
 
 @njit(cache=True)
@@ -275,7 +286,7 @@ def _fast_sum(buffer, count):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def squares(h0, l0, a0, h1, l1, a1, h2, l2, a2, count, buffer):
     """Sum over ``j < count`` of ``D_j**2`` from three windows of ``S`` (compensated differences)."""
     x0 = h0[a0 : a0 + count]
@@ -309,7 +320,7 @@ def plain_squares(h, a, m, count):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def certified(total, delta, count, tol):
     """Whether ``count`` squares summing to ``total`` are within ``tol`` (relative) of
     their exact sum when every squared value errs by at most ``delta``: the bound
@@ -319,7 +330,7 @@ def certified(total, delta, count, tol):
     return total > 0.0 and np.isfinite(total) and bound <= tol * total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def certified_squares(h, l, a, m, count, buffer, bounds):
     """:func:`squares` of one window (``S = h + l`` at offsets a, a + m, a + 2m) by the plain
     :func:`plain_squares` of ``h`` alone when its error is provably below :data:`CERTIFY_TOL`.
@@ -342,7 +353,7 @@ def certified_squares(h, l, a, m, count, buffer, bounds):
     return squares(h, l, a, h, l, a + m, h, l, a + 2 * m, count, buffer)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def window_level_sums(data, col, t0, need, centre, scale, wh, wl, w0, filled, factors, nd, count, block, out_row,
                       buffer, bounds):
     """Squared second differences of the first ``count`` levels for the block at ``t0``, from a sliding window.

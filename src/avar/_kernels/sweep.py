@@ -14,9 +14,10 @@ order, so the bits do not depend on the number of threads.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from avar._kernels.streaming import window_level_sums
+from avar._kernels.tasks import run_tasks
 
 #: Samples per block: the window's advance.
 SWEEP_BLOCK = 1 << 13
@@ -29,7 +30,7 @@ SWEEP_NEAR = 1 << 15
 SWEEP_CHUNK = 32
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def sweep_task(data, col, kb0, kb1, centre, scale, factors, nd, out_row, block):
     """Sums of ``D**2`` of every level for the differences starting in blocks ``kb0 .. kb1 - 1``."""
     n = data.shape[0]
@@ -41,7 +42,7 @@ def sweep_task(data, col, kb0, kb1, centre, scale, factors, nd, out_row, block):
     buffer = np.empty(block)
     bounds = np.zeros(2)  # largest |S| hi and lo parts the window has held
     w0 = kb0 * block
-    filled = 0
+    filled = np.int64(0)  # not the literal 0: window_level_sums compiles once
     # The window holds S less S[kb0 B] (differences need no anchor): its values stay the
     # size of the task's own excursion, which lets certified_squares use plain sums.
     wh[0] = 0.0
@@ -55,7 +56,6 @@ def sweep_task(data, col, kb0, kb1, centre, scale, factors, nd, out_row, block):
     return out_row
 
 
-@njit(cache=True, parallel=True)
 def sweep_sums(data, centre, scale, factors, nd, block, chunk):
     """Sums of ``D**2`` per (column, level), shape (C, L).
 
@@ -63,17 +63,17 @@ def sweep_sums(data, centre, scale, factors, nd, block, chunk):
     differences, all > 0.
     """
     channels = data.shape[1]
-    n_blocks = (nd[0] + block - 1) // block
-    n_chunks = (n_blocks + chunk - 1) // chunk
+    n_blocks = -(-int(nd[0]) // block)
+    n_chunks = -(-n_blocks // chunk)
     out = np.zeros((channels, n_chunks, factors.shape[0]))
-    for task in prange(channels * n_chunks):
-        c = task // n_chunks
-        j = task % n_chunks
+
+    def task(t):
+        c, j = divmod(t, n_chunks)
         sweep_task(data, c, j * chunk, min(n_blocks, (j + 1) * chunk), centre[c], scale[c], factors, nd, out[c, j],
                    block)
-    result = np.zeros((channels, factors.shape[0]))
-    for c in range(channels):
-        for j in range(n_chunks):
-            for k in range(factors.shape[0]):  # element by element: a row assignment would compile
-                result[c, k] += out[c, j, k]  # numba's shape-mismatch message (strings), seconds cold
+
+    run_tasks(channels * n_chunks, task)
+    result = out[:, 0].copy()
+    for j in range(1, n_chunks):  # in a fixed order: the bits do not depend on the threads
+        result += out[:, j]
     return result

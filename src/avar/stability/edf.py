@@ -4,8 +4,8 @@
 overlapping or not, modified or not), :func:`totdev_edf` (NIST SP 1065 Table
 7), :func:`estimator_edf` (by estimator name, per level) and
 :func:`chi2_bounds` (a variance estimate is sigma**2 chi2(edf) / edf).
-Everything is vectorized over the levels; Greenhall's sums are compiled
-(:mod:`avar._kernels.edf`).
+Everything is vectorized over the levels; Greenhall's sums are NumPy's for a few
+levels and compiled for many (:mod:`avar._kernels.edf`).
 """
 
 from __future__ import annotations
@@ -164,12 +164,10 @@ def greenhall_edf(alpha: Any, d: int, m: Any, n_phase: int, overlapping: bool, m
     denominator = np.where(coarse, J_MAX, denominator)
     if use_sum.any():
         k = np.flatnonzero(use_sum)
-        from avar._kernels.edf import basic_sums  # compiled: loaded on first use
+        from avar._kernels.edf import greenhall_sums  # compiled (for many rows): loaded on first use
 
-        out = np.empty(k.size)
-        basic_sums(sum_j[k], sum_m[k], sum_s[k], sum_f[k].astype(np.float64), alpha[k], d, norm[k],
-                   denominator[k], out)
-        inv[k] = out
+        inv[k] = greenhall_sums(sum_j[k], sum_m[k], sum_s[k], sum_f[k].astype(np.float64), alpha[k], d, norm[k],
+                                denominator[k])
     return (1.0 / inv).reshape(shape)
 
 
