@@ -47,6 +47,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -87,7 +88,6 @@ def structure_function(components: Sequence[Component], size: int) -> np.ndarray
 UNIT_KINDS = ("QN", "WN", "FN", "RW")
 
 
-@functools.lru_cache(maxsize=4)
 def _unit_structure(kind: str, size: int) -> np.ndarray:
     out = np.zeros(size + 1)
     if kind == "QN":
@@ -98,7 +98,6 @@ def _unit_structure(kind: str, size: int) -> np.ndarray:
         out[1:] = np.cumsum(4.0 / (math.pi * (2.0 * np.arange(1, size + 1) - 1.0)))
     else:
         out[:] = np.arange(size + 1, dtype=np.float64)
-    out.flags.writeable = False
     return out
 
 
@@ -162,21 +161,83 @@ def level_covariance(components: Sequence[Component], n: int, factors: np.ndarra
     factors = np.asarray(factors, dtype=np.int64)
     if factors.size > MAX_EXACT_LEVELS:
         return _interpolated(components, n, factors)
-    counts = n - 2 * factors + 1
-    top = int(factors.max())
     memory = any(c.kind in ("FN", "AR1") for c in components)
     # a Gauss-Markov term's covariance (phi^h) squared falls below 1e-6 of its start after this many lags
     memory_lags = max([math.ceil(7.0 / -math.log(c.shape)) for c in components if c.kind == "AR1"], default=0)
-    reach = min(int(counts.max()), (2 + 2 * TAIL) * 2 * top + memory_lags if memory else 2 * top + 2)
-    size = reach + 4 * top + 4
-    s2 = _second_sums(structure_function(components, size))
+    plan = _lag_plan(int(n), tuple(int(m) for m in factors), memory, memory_lags)
+    s2 = _combined_second_sums(components, plan.size)
     ramp = sum(c.scale for c in components if c.kind == "DR")
-    means = math.sqrt(ramp / 2.0) * factors.astype(np.float64)
+    mean2 = (ramp / 2.0) * plan.mj * plan.mk  # mu_j mu_k at every node, mu_m = sqrt(omega2 / 2) m
+    gamma = (_phi(s2, plan.mj - plan.h, plan.mj, plan.mk) + _phi(s2, -plan.h - plan.mk, plan.mj, plan.mk)
+             - _phi(s2, plan.mj - plan.mk - plan.h, plan.mj, plan.mk) - _phi(s2, -plan.h, plan.mj, plan.mk))
+    gamma /= 4.0 * plan.mj * plan.mk
+    totals = np.add.reduceat(plan.weights * (2.0 * gamma * gamma + 4.0 * mean2 * gamma), plan.starts)
     out = np.empty((factors.size, factors.size))
-    for j in range(factors.size):
-        for k in range(j, factors.size):
-            out[j, k] = out[k, j] = _pair(s2, int(factors[j]), int(factors[k]), int(counts[j]),
-                                          int(counts[k]), means[j] * means[k], memory, memory_lags)
+    out[plan.j, plan.k] = out[plan.k, plan.j] = totals / plan.norms
+    return out
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """The lags of every pair of levels: nodes h, their weights times pair counts, and the pairs' layout."""
+
+    h: np.ndarray
+    mj: np.ndarray
+    mk: np.ndarray
+    weights: np.ndarray
+    starts: np.ndarray
+    j: np.ndarray
+    k: np.ndarray
+    norms: np.ndarray
+    size: int
+
+
+@functools.lru_cache(maxsize=2)
+def _lag_plan(n: int, factors: tuple[int, ...], memory: bool, memory_lags: int) -> _Plan:
+    """The nodes of :func:`level_covariance` for one length and grid (shared by every channel of a log)."""
+    m = np.asarray(factors, dtype=np.int64)
+    counts = n - 2 * m + 1
+    top = int(m.max())
+    reach = min(int(counts.max()), (2 + 2 * TAIL) * 2 * top + memory_lags if memory else 2 * top + 2)
+    pieces = []
+    for j in range(m.size):
+        for k in range(j, m.size):
+            mj, mk, count_j, count_k = int(m[j]), int(m[k]), int(counts[j]), int(counts[k])
+            span = 2 * (mj + mk) * (1 + TAIL) + memory_lags if memory else 2 * (mj + mk) + 2
+            low, high = max(1 - count_j, -span), min(count_k - 1, span)  # s in 1..M_j and s + h in 1..M_k
+            # gamma's kinks: where an argument of S2 crosses 0; the pair count's: h = 0 and h = M_k - M_j
+            shifts = np.array([mj, -mk, mj - mk, 0])
+            ends = np.array([mj + 1, mj - mk + 1, 1, 1 - mk])
+            kinks = np.concatenate([(shifts[:, None] + ends[None, :]).ravel(), [0, count_k - count_j]])
+            h, weights = _nodes(low, high, kinks)
+            pairs = np.maximum(np.minimum(count_j, count_k - h) - np.maximum(1, 1 - h) + 1, 0)
+            pieces.append((j, k, h, weights * pairs, float(count_j) * float(count_k)))
+    lengths = np.array([p[2].size for p in pieces])
+    return _Plan(h=np.concatenate([p[2] for p in pieces]),
+                 mj=np.repeat([int(m[p[0]]) for p in pieces], lengths),
+                 mk=np.repeat([int(m[p[1]]) for p in pieces], lengths),
+                 weights=np.concatenate([p[3] for p in pieces]),
+                 starts=np.concatenate([[0], np.cumsum(lengths)[:-1]]),
+                 j=np.array([p[0] for p in pieces]), k=np.array([p[1] for p in pieces]),
+                 norms=np.array([p[4] for p in pieces]), size=reach + 4 * top + 4)
+
+
+def _combined_second_sums(components: Sequence[Component], size: int) -> np.ndarray:
+    """S2 of the model: the scales times the cached unit tables, plus any Gauss-Markov term's own."""
+    out = np.zeros(size + 3)  # S2(0..size + 2)
+    for c in components:
+        if c.kind in UNIT_KINDS:
+            out += c.scale * _unit_second_sums(c.kind, size)
+    shaped = [c for c in components if c.kind == "AR1"]
+    if shaped:
+        out += _second_sums(structure_function(shaped, size))
+    return out
+
+
+@functools.lru_cache(maxsize=len(UNIT_KINDS))  # one log's length: the channels of a report share them
+def _unit_second_sums(kind: str, size: int) -> np.ndarray:
+    out = _second_sums(_unit_structure(kind, size))
+    out.flags.writeable = False
     return out
 
 
@@ -209,24 +270,6 @@ def _interpolated(components: Sequence[Component], n: int, factors: np.ndarray) 
     return out * np.outer(nu, nu)
 
 
-def _phi(s2: np.ndarray, c: np.ndarray, l1: int, l2: int) -> np.ndarray:
-    """sum_{i<l1} sum_{l<l2} D(c + i - l) for integer arrays c."""
+def _phi(s2: np.ndarray, c: np.ndarray, l1: np.ndarray | int, l2: np.ndarray | int) -> np.ndarray:
+    """sum_{i<l1} sum_{l<l2} D(c + i - l) for integer arrays c (l1, l2 arrays of the same shape, or ints)."""
     return _s2(s2, c + l1 + 1) - _s2(s2, c + l1 - l2 + 1) - _s2(s2, c + 1) + _s2(s2, c - l2 + 1)
-
-
-def _pair(s2: np.ndarray, mj: int, mk: int, count_j: int, count_k: int, mean2: float,
-          memory: bool, memory_lags: int) -> float:
-    """Cov(nu_hat_j, nu_hat_k) from gamma_jk(h) summed over the lags with pairs."""
-    span = 2 * (mj + mk) * (1 + TAIL) + memory_lags if memory else 2 * (mj + mk) + 2
-    low, high = max(1 - count_j, -span), min(count_k - 1, span)  # s in 1..M_j and s + h in 1..M_k
-    # gamma's kinks: where an argument of S2 crosses 0; the pair count's: h = 0 and h = M_k - M_j
-    shifts = np.array([mj, -mk, mj - mk, 0])
-    ends = np.array([mj + 1, mj - mk + 1, 1, 1 - mk])
-    kinks = np.concatenate([(shifts[:, None] + ends[None, :]).ravel(), [0, count_k - count_j]])
-    h, weights = _nodes(low, high, kinks)
-    gamma = (_phi(s2, mj - h, mj, mk) + _phi(s2, -h - mk, mj, mk) - _phi(s2, mj - mk - h, mj, mk)
-             - _phi(s2, -h, mj, mk))
-    gamma /= 4.0 * mj * mk
-    pairs = np.maximum(np.minimum(count_j, count_k - h) - np.maximum(1, 1 - h) + 1, 0).astype(np.float64)
-    total = np.dot(weights * pairs, 2.0 * gamma * gamma + 4.0 * mean2 * gamma)
-    return float(total / (float(count_j) * float(count_k)))
