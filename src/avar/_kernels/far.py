@@ -125,7 +125,7 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
     reach = 2 * (factors[n_levels - 1] // factors[0])  # farthest piece a level reads, in class steps
     ring = reach + 2  # the pieces a level reads, and the one filled ahead
     wide = _is_wide(rows[col, 0])  # 64-bit integers: every piece exact, by its steps
-    prefixes = np.empty((0 if wide else ring, fine))
+    prefixes = np.empty((0 if wide else ring) * fine)  # slot s: [s fine, (s + 1) fine); 1-d, as every allocation
     errors = np.empty(ring)
     bigs = np.empty(ring)
     ready = 0  # class steps whose local prefix is in the ring
@@ -137,7 +137,7 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
             p = first + stride * ready
             count = min(fine, n - p * fine)
             slot = ready % ring
-            bigs[slot] = local_prefix(rows, col, p * fine, count, centre, sc, prefixes[slot])
+            bigs[slot] = local_prefix(rows, col, p * fine, count, centre, sc, prefixes[slot * fine : (slot + 1) * fine])
             errors[slot] = prefix_error_bound(count, spread[col, p], bigs[slot])
             ready += 1
         for k in range(n_levels):
@@ -151,7 +151,7 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
             ch, cl = _base(th, tl, col, q, q + o, q + 2 * o)
             h = o // stride
             s0, s1, s2 = j % ring, (j + h) % ring, (j + 2 * h) % ring
-            total = prefix_squares(prefixes[s0], prefixes[s1], prefixes[s2], ch, cl, cnt)
+            total = prefix_squares(prefixes[s0 * fine :], prefixes[s1 * fine :], prefixes[s2 * fine :], ch, cl, cnt)
             table_mag = abs(th[col, q]) + 2.0 * abs(th[col, q + o]) + abs(th[col, q + 2 * o])
             delta = difference_error_bound(errors[s0] + 2.0 * errors[s1] + errors[s2],
                                            bigs[s0] + 2.0 * bigs[s1] + bigs[s2], ch, cl, table_mag)

@@ -40,7 +40,9 @@ def sweep_task(data, col, kb0, kb1, centre, scale, factors, nd, out_row, block):
     wh = np.empty(cap)
     wl = np.empty(cap)
     buffer = np.empty(block)
-    bounds = np.zeros(2)  # largest |S| hi and lo parts the window has held
+    bounds = np.empty(2)  # largest |S| hi and lo parts the window has held (np.zeros would compile more)
+    bounds[0] = 0.0
+    bounds[1] = 0.0
     w0 = kb0 * block
     filled = np.int64(0)  # not the literal 0: window_level_sums compiles once
     # The window holds S less S[kb0 B] (differences need no anchor): its values stay the
