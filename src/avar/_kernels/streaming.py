@@ -55,6 +55,15 @@ NEAR_LEN = 2 * NEAR + 4 * BLOCK
 LIMIT_EXP = 400
 
 
+def read_only(x: np.ndarray) -> np.ndarray:
+    """``x``, or a read-only view of it: numba compiles a kernel once for read-only input
+    rather than again for writable arrays of the same dtype and layout."""
+    if x.flags.writeable:
+        x = x.view()
+        x.flags.writeable = False
+    return x
+
+
 @njit(cache=True, inline="always")
 def _two_sum(a, b):
     s = a + b
