@@ -149,7 +149,7 @@ def test_octave_kernels_bits_do_not_depend_on_thread_count(type):
 def test_small_path_matches_loop_on_every_scale(type):
     x = adversarial(301)["step"]
     factors = np.arange(1, 151, dtype=np.int64)
-    got = small_allan_variance(x[:, None], factors, n_diff(301, factors, type), type == "mo", False)[0]
+    got = small_allan_variance(columns._as_kernel_input(x), factors, n_diff(301, factors, type), type == "mo", False)[0]
     np.testing.assert_allclose(got, exact(x, factors, type), rtol=1e-10)
 
 
@@ -199,7 +199,7 @@ def test_small_path_on_threads_is_exact_and_thread_independent(name):
     factors = octave(n, first=0)
     nd = n_diff(n, factors, "mo")
     got = small_allan_variance_parallel(x[:, None], factors, nd, True, False)[0]
-    np.testing.assert_array_equal(got, small_allan_variance(x[:, None], factors, nd, True, False)[0])
+    np.testing.assert_array_equal(got, small_allan_variance(columns._as_kernel_input(x), factors, nd, True, False)[0])
     threads = numba.get_num_threads()
     try:
         numba.set_num_threads(1)

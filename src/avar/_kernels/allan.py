@@ -36,9 +36,10 @@ to ``S``.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from avar._kernels.streaming import _fast_sum, _two_sum
+from avar._kernels.tasks import run_ranges, run_tasks
 
 #: Number of differences one parallel task sums (tasks are (channel, level,
 #: chunk) triples; the chunk size fixes the summation order, so results do
@@ -64,11 +65,27 @@ def _centred(xi, ctr, sc):
     return yh * sc, yl * sc
 
 
-@njit(cache=True, parallel=True, nogil=True)
+@njit(cache=True, nogil=True)
+def _cumsum_block(data, c, b, block, centre, scale, start_hi, start_lo, hi, lo, write):
+    """Compensated sum of block ``b`` of ``(data[:, c] - centre) * scale`` from
+    ``start_hi + start_lo``; with ``write``, its running sums are written to ``hi, lo``."""
+    n = data.shape[0]
+    total = start_hi
+    comp = start_lo
+    for i in range(b * block, min(n, (b + 1) * block)):
+        yh, yl = _centred(data[i, c], centre, scale)
+        total, err = _two_sum(total, yh)
+        comp += err + yl
+        if write:
+            hi[c, i + 1] = total
+            lo[c, i + 1] = comp
+    return total, comp
+
+
 def centred_cumsum(data, centre, scale, hi, lo, block=CUMSUM_BLOCK):
     """Fill ``hi``, ``lo`` with compensated cumulative sums of ``(data[:, c] - centre[c]) * scale[c]``.
 
-    Two passes over blocks of ``block`` samples, both parallel: the first
+    Two passes over blocks of ``block`` samples, both on the threads: the first
     sums every block, an exact (double-double) scan turns the block sums into
     offsets, the second writes the running sums of every block from its
     offset. The block size, not the thread count, fixes the arithmetic.
@@ -88,43 +105,31 @@ def centred_cumsum(data, centre, scale, hi, lo, block=CUMSUM_BLOCK):
     otherwise cost more than the arithmetic.
     """
     n, channels = data.shape
-    n_blocks = (n + block - 1) // block
-    block_hi = np.empty((channels, n_blocks))
-    block_lo = np.empty((channels, n_blocks))
-    for task in prange(channels * n_blocks):
-        c = task // n_blocks
-        b = task % n_blocks
-        total = 0.0
-        comp = 0.0
-        for i in range(b * block, min(n, (b + 1) * block)):
-            yh, yl = _centred(data[i, c], centre[c], scale[c])
-            total, err = _two_sum(total, yh)
-            comp += err + yl
-        block_hi[c, b] = total
-        block_lo[c, b] = comp
-    for c in range(channels):
-        total = 0.0
-        comp = 0.0
+    n_blocks = -(-n // block)
+    sums = np.empty((channels, n_blocks, 2))
+
+    def first(t):
+        c, b = divmod(t, n_blocks)
+        sums[c, b] = _cumsum_block(data, c, b, block, centre[c], scale[c], 0.0, 0.0, hi, lo, False)
+
+    run_tasks(channels * n_blocks, first)
+    offsets = np.empty_like(sums)
+    for c in range(channels):  # the blocks' offsets, in order (double-double)
+        total, comp = 0.0, 0.0
         for b in range(n_blocks):
-            offset_hi = block_hi[c, b]
-            block_hi[c, b] = total
-            offset_lo = block_lo[c, b]
-            block_lo[c, b] = comp
-            total, err = _two_sum(total, offset_hi)
-            comp += err + offset_lo
+            offsets[c, b] = total, comp
+            s = total + sums[c, b, 0]
+            bv = s - total
+            comp += ((total - (s - bv)) + (sums[c, b, 0] - bv)) + sums[c, b, 1]
+            total = s
         hi[c, 0] = 0.0
         lo[c, 0] = 0.0
-    for task in prange(channels * n_blocks):
-        c = task // n_blocks
-        b = task % n_blocks
-        total = block_hi[c, b]
-        comp = block_lo[c, b]
-        for i in range(b * block, min(n, (b + 1) * block)):
-            yh, yl = _centred(data[i, c], centre[c], scale[c])
-            total, err = _two_sum(total, yh)
-            comp += err + yl
-            hi[c, i + 1] = total
-            lo[c, i + 1] = comp
+
+    def second(t):
+        c, b = divmod(t, n_blocks)
+        _cumsum_block(data, c, b, block, centre[c], scale[c], offsets[c, b, 0], offsets[c, b, 1], hi, lo, True)
+
+    run_tasks(channels * n_blocks, second)
 
 
 #: Length of the per-task scratch buffer: the squared differences of a block
@@ -167,7 +172,23 @@ def _strided_squares(hi, lo, m, stride, start, count, buffer):
     return _fast_sum(buffer, count)
 
 
-@njit(cache=True, parallel=True, nogil=True)
+@njit(cache=True, nogil=True)
+def _fused_block(hi, lo, c, b, factors, n_differences, block, out):
+    """The sums of every level over differences ``[b block, (b + 1) block)`` of channel ``c``."""
+    buffer = np.empty(BLOCK)
+    h = hi[c]
+    l = lo[c]
+    start = b * block
+    for k in range(factors.shape[0]):
+        stop = min(start + block, n_differences[k])
+        if stop <= start:
+            break
+        total = 0.0
+        for first in range(start, stop, BLOCK):
+            total += _contiguous_squares(h, l, factors[k], first, min(BLOCK, stop - first), buffer)
+        out[c, b, k] = total
+
+
 def fused_overlapping_sums(hi, lo, factors, n_differences, block=FUSED_BLOCK):
     """Maximal-overlap sums of all levels, one time block per task.
 
@@ -180,38 +201,18 @@ def fused_overlapping_sums(hi, lo, factors, n_differences, block=FUSED_BLOCK):
     Returns the per-block sums, shape (C, n_blocks, L).
     """
     channels = hi.shape[0]
-    n_levels = factors.shape[0]
-    n_blocks = (n_differences[0] + block - 1) // block
-    out = np.zeros((channels, n_blocks, n_levels))
-    for task in prange(channels * n_blocks):
-        c = task // n_blocks
-        start = (task % n_blocks) * block
-        buffer = np.empty(BLOCK)
-        h = hi[c]
-        l = lo[c]
-        for k in range(n_levels):
-            stop = min(start + block, n_differences[k])
-            if stop <= start:
-                break
-            total = 0.0
-            for first in range(start, stop, BLOCK):
-                total += _contiguous_squares(h, l, factors[k], first, min(BLOCK, stop - first), buffer)
-            out[c, task % n_blocks, k] = total
+    n_blocks = -(-int(n_differences[0]) // block)
+    out = np.zeros((channels, n_blocks, factors.shape[0]))
+    run_tasks(channels * n_blocks, lambda t: _fused_block(hi, lo, *divmod(t, n_blocks), factors, n_differences, block,
+                                                          out))
     return out
 
 
-@njit(cache=True, parallel=True, nogil=True)
-def task_sums(hi, lo, task_channel, task_factor, task_stride, task_first, task_last):
-    """Evaluate every task's sum of squared second differences in parallel.
-
-    Task ``i`` sums ``D_k**2`` of channel ``task_channel[i]`` at cluster size
-    ``task_factor[i]`` and stride ``task_stride[i]`` for
-    ``k in [task_first[i], task_last[i])``.
-    """
-    n_tasks = task_channel.shape[0]
-    out = np.empty(n_tasks, dtype=np.float64)
-    for i in prange(n_tasks):
-        buffer = np.empty(BLOCK)
+@njit(cache=True, nogil=True)
+def _task_range(hi, lo, task_channel, task_factor, task_stride, task_first, task_last, first_task, stop_task, out):
+    """Tasks ``first_task .. stop_task - 1`` of :func:`task_sums`, each into its own ``out[i]``."""
+    buffer = np.empty(BLOCK)
+    for i in range(first_task, stop_task):
         h = hi[task_channel[i]]
         l = lo[task_channel[i]]
         m = task_factor[i]
@@ -224,6 +225,18 @@ def task_sums(hi, lo, task_channel, task_factor, task_stride, task_first, task_l
             else:
                 total += _strided_squares(h, l, m, stride, first, count, buffer)
         out[i] = total
+
+
+def task_sums(hi, lo, task_channel, task_factor, task_stride, task_first, task_last):
+    """Evaluate every task's sum of squared second differences, on the threads.
+
+    Task ``i`` sums ``D_k**2`` of channel ``task_channel[i]`` at cluster size
+    ``task_factor[i]`` and stride ``task_stride[i]`` for
+    ``k in [task_first[i], task_last[i])``.
+    """
+    out = np.empty(task_channel.shape[0], dtype=np.float64)
+    run_ranges(out.shape[0], lambda first, stop: _task_range(hi, lo, task_channel, task_factor, task_stride, task_first,
+                                                             task_last, first, stop, out))
     return out
 
 

@@ -9,7 +9,7 @@ from avar._kernels.haar import CHUNK_BLOCKS as HAAR_CHUNK
 from avar._kernels.haar import PYRAMID_EXP, haar_sums
 from avar._kernels.levels import level_sums
 from avar._kernels.small import small_allan_variance, small_allan_variance_parallel
-from avar._kernels.streaming import BLOCK, CERTIFY_TOL, CHUNK_BLOCKS, LIMIT_EXP, NEAR, block_table
+from avar._kernels.streaming import BLOCK, CERTIFY_TOL, CHUNK_BLOCKS, LIMIT_EXP, NEAR, block_table, read_only
 from avar._kernels.sweep import SWEEP_BLOCK, SWEEP_CHUNK, SWEEP_NEAR, sweep_sums
 
 #: Series of at most this many samples take the one-call small path
@@ -53,6 +53,7 @@ def _table(data, block):
 
 def run_levels(data, factors, n_diff, is_mo, block=BLOCK, near=NEAR, chunk=CHUNK_BLOCKS):
     """Any grid (``factors`` increasing, all valid): level by level (:mod:`avar._kernels.levels`)."""
+    data = read_only(data)
     th, tl, centre, scale, _ = _table(data, block)
     counts = n_diff if is_mo else data.shape[0] // factors
     small_count = int(np.searchsorted(factors, near, side="right")) if is_mo else factors.shape[0]
@@ -71,6 +72,7 @@ def _chunk(n, block, most):
 
 def run_haar(data, factors, n_diff, exp=PYRAMID_EXP, chunk=None):
     """"to" at power-of-two cluster sizes ``factors`` (increasing): the Haar pyramid."""
+    data = read_only(data)
     exps = np.log2(factors).astype(np.int64)
     n_levels = int(exps[-1]) + 1
     chunk = _chunk(data.shape[0], 1 << exp, HAAR_CHUNK) if chunk is None else chunk
@@ -90,6 +92,7 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
     (:mod:`avar._kernels.far`, table granularity ``fine``, certification tolerance ``tol``),
     in groups whose largest factor is at most ``span`` times their smallest (a task's ring
     of local prefixes holds ``2 span + 2`` pieces: 8 MB by default, whatever N)."""
+    data = read_only(data)
     n_small = int(np.searchsorted(factors, near))
     fine = min(fine, int(factors[n_small])) if n_small < factors.shape[0] else fine
     th, tl, centre, scale, spread = _table(data, fine)
@@ -120,10 +123,7 @@ def _as_kernel_input(data) -> np.ndarray:
         x = x.astype(np.float64)
     elif x.dtype == np.float16:
         x = x.astype(np.float32)  # exact; numba has no float16 arithmetic
-    if x.flags.writeable:
-        x = x.view()
-        x.flags.writeable = False
-    return x
+    return read_only(x)
 
 
 def allan_variance_columns(data, factors, type: str) -> np.ndarray:

@@ -32,7 +32,9 @@ row by row (each row of a block is two or three segment sums).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
+
+from avar._kernels.tasks import run_tasks
 
 #: Rows per strip and side of the tiles of the symmetry check.
 COV_TILE = 64
@@ -226,46 +228,41 @@ def _cov_check_strip(c, bits, r0, r1, stop, mirror, tile, asym, top):
     return asym, top
 
 
-@njit(cache=True, parallel=True)
-def _cov_tasks(c, beta, width, noav_ns, noav_scan, tile, split, far, asym, top, sums, acc,
-               f, pre):
-    """The two tasks of :func:`covariance_pass` (the only parallel loop: with
-    ``parallel=True`` numba turns every array expression into a parallel loop of
-    its own, each costing compile time, so nothing else is here)."""
+@njit(cache=True, nogil=True)
+def _cov_task(task, c, beta, width, noav_ns, noav_scan, tile, split, far, asym, top, sums, acc, f, pre):
+    """Task ``task`` (0: the top, walking down; 1: the bottom, walking up) of :func:`covariance_pass`."""
     t = c.shape[0]
     half = width // 2
     bits = c.view(np.int64)
-    for task in prange(2):
-        down = task == 0  # the top task walks down, the bottom one up
-        run_asym = 0.0
-        run_top = np.int64(0)
-        scan_buffer = pre[task, :pre.shape[1] - 8]  # the rest is padding
-        # own rows (check, diagonal sums, NOAV), then the rest of the task's corner
-        n_own = split if down else t - split
-        if down:
-            n_rest = max(0, width - 1 - split)  # rows split .. width - 2
-        else:
-            n_rest = max(0, split - max(t - width + 1, 0))  # rows split - 1 .. T - width + 1
-        for k in range(n_own + n_rest):
-            r = k if down else t - 1 - k
-            band = k < n_own
-            if band and (r % tile == 0 if down else (r + 1) % tile == 0 or r == t - 1):
-                r0 = r - r % tile  # a new strip of rows [r0, r1)
-                r1 = min(split if down else t, r0 + tile)
-                mirror = split if not down and r0 >= far else 0
-                run_asym, run_top = _cov_check_strip(c, bits, r0, r1, far if down else t,
-                                                     mirror, tile, run_asym, run_top)
-            if width > 0:
-                _cov_moav_row(c[r], r, t, beta, width, half, band, down, f[task], sums[task])
-            if band and noav_ns.shape[0] > 0:
-                _cov_noav_row(c[r], r, t, noav_ns, acc[task], noav_scan, scan_buffer)
-        asym[task] = run_asym
-        top[task] = run_top
+    down = task == 0  # the top task walks down, the bottom one up
+    run_asym = 0.0
+    run_top = np.int64(0)
+    scan_buffer = pre[task, :pre.shape[1] - 8]  # the rest is padding
+    # own rows (check, diagonal sums, NOAV), then the rest of the task's corner
+    n_own = split if down else t - split
+    if down:
+        n_rest = max(0, width - 1 - split)  # rows split .. width - 2
+    else:
+        n_rest = max(0, split - max(t - width + 1, 0))  # rows split - 1 .. T - width + 1
+    for k in range(n_own + n_rest):
+        r = k if down else t - 1 - k
+        band = k < n_own
+        if band and (r % tile == 0 if down else (r + 1) % tile == 0 or r == t - 1):
+            r0 = r - r % tile  # a new strip of rows [r0, r1)
+            r1 = min(split if down else t, r0 + tile)
+            mirror = split if not down and r0 >= far else 0
+            run_asym, run_top = _cov_check_strip(c, bits, r0, r1, far if down else t,
+                                                 mirror, tile, run_asym, run_top)
+        if width > 0:
+            _cov_moav_row(c[r], r, t, beta, width, half, band, down, f[task], sums[task])
+        if band and noav_ns.shape[0] > 0:
+            _cov_noav_row(c[r], r, t, noav_ns, acc[task], noav_scan, scan_buffer)
+    asym[task] = run_asym
+    top[task] = run_top
 
 
-@njit(cache=True)
 def covariance_pass(c, width, noav_ns, noav_scan, noav_width, tile=COV_TILE):
-    """Check ``c`` and gather the MOAV / NOAV sums, in one parallel pass.
+    """Check ``c`` and gather the MOAV / NOAV sums, in one pass of two tasks on the threads.
 
     Parameters
     ----------
@@ -300,11 +297,10 @@ def covariance_pass(c, width, noav_ns, noav_scan, noav_width, tile=COV_TILE):
     check about T^2 / 4 pairs.
     """
     t = c.shape[0]
-    beta = np.empty(width)
-    for d in range(width):
-        mid = (t - 1 - d) // 2
-        beta[d] = c[mid, mid + d]
-    n_strips = (t + tile - 1) // tile
+    d = np.arange(width)
+    mid = (t - 1 - d) // 2
+    beta = c[mid, mid + d].astype(np.float64)
+    n_strips = -(-t // tile)
     split = min(t, (n_strips // 2) * tile)
     far = min(t, max(split, ((3 * n_strips + 2) // 4) * tile))
     asym = np.zeros(2)
@@ -314,17 +310,12 @@ def covariance_pass(c, width, noav_ns, noav_scan, noav_width, tile=COV_TILE):
     acc = np.zeros((2, noav_ns.shape[0] + 8))
     f = np.empty((2, width + 8))
     pre = np.empty((2, noav_width + 9))
-    _cov_tasks(c, beta, width, noav_ns, noav_scan, tile, split, far, asym, top, sums, acc,
-               f, pre)
+    run_tasks(2, lambda task: _cov_task(task, c, beta, width, noav_ns, noav_scan, tile, split, far, asym, top, sums,
+                                        acc, f, pre))
     n = noav_ns.shape[0]
-    noav = np.empty(n)
-    for k in range(n):
-        noav[k] = acc[0, k] + acc[1, k]
-    out = np.empty((4, width))
-    for k, row in enumerate((0, 3, 4, 5)):
-        for d in range(width):
-            out[k, d] = sums[0, row, d] + sums[1, row, d]
-    return max(asym[0], asym[1]), max(top[0], top[1]), beta, out[0], out[1], out[2], out[3], noav
+    noav = acc[0, :n] + acc[1, :n]
+    out = sums[0][[0, 3, 4, 5], :width] + sums[1][[0, 3, 4, 5], :width]
+    return float(max(asym[0], asym[1])), int(max(top[0], top[1])), beta, out[0], out[1], out[2], out[3], noav
 
 
 @njit(cache=True)

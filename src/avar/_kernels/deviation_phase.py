@@ -10,10 +10,11 @@ by a compensated running sum ``hi + lo``.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from avar._kernels.allan import CUMSUM_BLOCK
 from avar._kernels.streaming import _two_sum
+from avar._kernels.tasks import run_tasks
 
 
 @njit(cache=True)
@@ -66,36 +67,35 @@ def _scan_block_fast(data, start, stop, weigh):
     return count, total, min(min(l0, l1), min(l2, l3)), max(max(h0, h1), max(h2, h3)), weighted
 
 
-@njit(cache=True, parallel=True, nogil=True)
+@njit(cache=True, nogil=True)
+def _scan_task(data, b, block, weigh, half, nans, sums, lows, highs, moments):
+    """Block ``b`` of :func:`scan`, into its own slots."""
+    start, stop = b * block, min(data.shape[0], (b + 1) * block)
+    nans[b], sums[b], lows[b], highs[b], weighted = _scan_block_fast(data, start, stop, weigh)
+    moments[b] = weighted + (start - half) * sums[b]
+    if nans[b] > 0:
+        nans[b], sums[b], lows[b], highs[b] = _scan_block(data, start, stop)
+
+
 def scan(data, block=CUMSUM_BLOCK, weigh=False):
-    """Number of NaN, and sum, minimum and maximum of the other values, in one parallel pass;
+    """Number of NaN, and sum, minimum and maximum of the other values, in one pass on the threads;
     with ``weigh`` and no NaN, also the centred moment ``sum_i (i - (N - 1) / 2) data_i``
     (the numerator of the least-squares slope; NaN otherwise)."""
     n = data.shape[0]
-    n_blocks = (n + block - 1) // block
+    n_blocks = -(-n // block)
     nans = np.zeros(n_blocks, dtype=np.int64)
-    sums = np.zeros(n_blocks)
-    lows = np.full(n_blocks, np.inf)
-    highs = np.full(n_blocks, -np.inf)
-    moments = np.zeros(n_blocks)
+    sums, lows, highs, moments = np.zeros(n_blocks), np.full(n_blocks, np.inf), np.full(n_blocks, -np.inf), \
+        np.zeros(n_blocks)
     half = (n - 1) / 2.0
-    for b in prange(n_blocks):
-        start, stop = b * block, min(n, (b + 1) * block)
-        nans[b], sums[b], lows[b], highs[b], weighted = _scan_block_fast(data, start, stop, weigh)
-        moments[b] = weighted + (start - half) * sums[b]
-        if nans[b] > 0:
-            nans[b], sums[b], lows[b], highs[b] = _scan_block(data, start, stop)
-    count = 0
+    run_tasks(n_blocks, lambda b: _scan_task(data, b, block, bool(weigh), half, nans, sums, lows, highs, moments))
     total = 0.0
-    low = np.inf
-    high = -np.inf
     moment = 0.0
     for b in range(n_blocks):  # in order: the result does not depend on the thread count
-        count += nans[b]
-        total += sums[b]
-        low = min(low, lows[b])
-        high = max(high, highs[b])
-        moment += moments[b]
+        total += float(sums[b])
+        moment += float(moments[b])
+    count = int(nans.sum())
+    low = float(lows.min()) if n_blocks else np.inf
+    high = float(highs.max()) if n_blocks else -np.inf
     return count, total, low, high, moment if count == 0 and weigh else np.nan
 
 
@@ -117,7 +117,23 @@ def _increment(data, data_lo, i, kind, centre, slope, scale):
     return h * scale, (l + e2) * scale
 
 
-@njit(cache=True, parallel=True, nogil=True)
+@njit(cache=True, nogil=True)
+def _phase_block(data, data_lo, kind, centre, slope, scale, b, block, start_hi, start_lo, hi, lo, write):
+    """Compensated sum of the increments of block ``b`` from ``start_hi + start_lo``; with
+    ``write``, the running sums are written to ``hi, lo``."""
+    n = hi.shape[0] - 1
+    total = start_hi
+    comp = start_lo
+    for i in range(b * block, min(n, (b + 1) * block)):
+        h, l = _increment(data, data_lo, i, kind, centre, slope, scale)
+        total, err = _two_sum(total, h)
+        comp += err + l
+        if write:
+            hi[i + 1] = total
+            lo[i + 1] = comp
+    return total, comp
+
+
 def detrended_phase(data, data_lo, kind, centre, slope, scale, hi, lo, block=CUMSUM_BLOCK):
     """Fill ``hi`` (float64), ``lo`` (float32; length M + 1) with the compensated running sum of the increments.
 
@@ -127,43 +143,31 @@ def detrended_phase(data, data_lo, kind, centre, slope, scale, hi, lo, block=CUM
     running sum of the phase, for MDEV). ``data_lo`` is unused (any float32
     array) for kinds 0 and 1. Increment ``i``
     enters as ``(increment - centre - slope i) scale``; ``slope i`` must be
-    exact and ``scale`` a power of two. ``hi[0] = lo[0] = 0``. Two parallel
-    passes over blocks with an exact scan of the block sums between them: the
+    exact and ``scale`` a power of two. ``hi[0] = lo[0] = 0``. Two passes over
+    blocks on the threads with an exact scan of the block sums between them: the
     block size, not the thread count, fixes the arithmetic.
     """
     n = hi.shape[0] - 1
-    n_blocks = (n + block - 1) // block
-    block_hi = np.zeros(n_blocks)
-    block_lo = np.zeros(n_blocks)
-    for b in prange(n_blocks):
-        total = 0.0
-        comp = 0.0
-        for i in range(b * block, min(n, (b + 1) * block)):
-            h, l = _increment(data, data_lo, i, kind, centre, slope, scale)
-            total, err = _two_sum(total, h)
-            comp += err + l
-        block_hi[b] = total
-        block_lo[b] = comp
-    total = 0.0
-    comp = 0.0
-    for b in range(n_blocks):
-        offset_hi = block_hi[b]
-        offset_lo = block_lo[b]
-        block_hi[b] = total
-        block_lo[b] = comp
-        total, err = _two_sum(total, offset_hi)
-        comp += err + offset_lo
+    n_blocks = -(-n // block)
+    centre, slope, scale = float(centre), float(slope), float(scale)
+    sums = np.zeros((n_blocks, 2))
+
+    def first(b):
+        sums[b] = _phase_block(data, data_lo, kind, centre, slope, scale, b, block, 0.0, 0.0, hi, lo, False)
+
+    run_tasks(n_blocks, first)
+    offsets = np.zeros_like(sums)
+    total, comp = 0.0, 0.0
+    for b in range(n_blocks):  # the blocks' offsets, in order (double-double)
+        offsets[b] = total, comp
+        s = total + sums[b, 0]
+        bv = s - total
+        comp += ((total - (s - bv)) + (sums[b, 0] - bv)) + sums[b, 1]
+        total = s
     hi[0] = 0.0
     lo[0] = 0.0
-    for b in prange(n_blocks):
-        total = block_hi[b]
-        comp = block_lo[b]
-        for i in range(b * block, min(n, (b + 1) * block)):
-            h, l = _increment(data, data_lo, i, kind, centre, slope, scale)
-            total, err = _two_sum(total, h)
-            comp += err + l
-            hi[i + 1] = total
-            lo[i + 1] = comp
+    run_tasks(n_blocks, lambda b: _phase_block(data, data_lo, kind, centre, slope, scale, b, block, offsets[b, 0],
+                                               offsets[b, 1], hi, lo, True))
 
 
 @njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
@@ -178,19 +182,21 @@ def _centred_moment_block(data, kind, start, stop, half):
     return total
 
 
-@njit(cache=True, nogil=True, parallel=True)
 def centred_moment(data, kind, block=CUMSUM_BLOCK):
     """sum_i (i - (M - 1) / 2) increment_i over the M increments (``kind`` 0: ``data`` itself; 1: its differences).
 
-    Blocks in parallel, added in order: the bits do not depend on the thread count.
+    Blocks on the threads, added in order: the bits do not depend on the thread count.
     """
     count = data.shape[0] - kind
     half = (count - 1) / 2.0
-    n_blocks = (count + block - 1) // block
+    n_blocks = -(-count // block)
     parts = np.zeros(max(n_blocks, 1))
-    for b in prange(n_blocks):
+
+    def task(b):
         parts[b] = _centred_moment_block(data, kind, b * block, min(count, (b + 1) * block), half)
+
+    run_tasks(n_blocks, task)
     total = 0.0
     for b in range(n_blocks):
-        total += parts[b]
+        total += float(parts[b])
     return total

@@ -48,11 +48,12 @@ cumulative sum (any finite value keeps the other terms exact).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from avar._kernels.allan import _contiguous_squares, squared_difference_sums
 from avar._kernels.deviation_phase import detrended_phase, scan  # noqa: F401 (re-exported)
 from avar._kernels.streaming import _fast_sum
+from avar._kernels.tasks import run_ranges
 
 #: Terms per parallel task (MDEV tasks span at least m terms).
 CHUNK = 1 << 15
@@ -271,9 +272,18 @@ def _task_sum(hi, lo, code, m, stride, first, last_term, mode, bad, buffer):
     return total, used
 
 
-@njit(cache=True, parallel=True, nogil=True)
+@njit(cache=True, nogil=True)
+def _task_range(hi, lo, code, task_m, task_stride, task_first, task_last, mode, bad, first, stop, sums, counts):
+    """Tasks ``first .. stop - 1`` of :func:`task_sums`, each into its own slot."""
+    buffer = np.empty(BLOCK)
+    for t in range(first, stop):
+        sums[t], counts[t] = _task_sum(
+            hi, lo, code, task_m[t], task_stride[t], task_first[t], task_last[t], mode, bad, buffer
+        )
+
+
 def task_sums(hi, lo, code, task_m, task_stride, task_first, task_last, mode, bad):
-    """Sums of squared terms and term counts of every task, in parallel.
+    """Sums of squared terms and term counts of every task, on the threads.
 
     Task ``t`` covers terms ``task_first[t] .. task_last[t] - 1`` of the level
     with averaging factor ``task_m[t]`` and stride ``task_stride[t]`` between
@@ -283,11 +293,8 @@ def task_sums(hi, lo, code, task_m, task_stride, task_first, task_last, mode, ba
     n_tasks = task_m.shape[0]
     sums = np.empty(n_tasks)
     counts = np.empty(n_tasks, dtype=np.int64)
-    for t in prange(n_tasks):
-        buffer = np.empty(BLOCK)
-        sums[t], counts[t] = _task_sum(
-            hi, lo, code, task_m[t], task_stride[t], task_first[t], task_last[t], mode, bad, buffer
-        )
+    run_ranges(n_tasks, lambda first, stop: _task_range(hi, lo, code, task_m, task_stride, task_first, task_last, mode,
+                                                        bad, first, stop, sums, counts))
     return sums, counts
 
 

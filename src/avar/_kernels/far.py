@@ -43,8 +43,7 @@ import numpy as np
 from numba import njit
 
 from avar._kernels.far_steps import _base, exact_sums
-from avar._kernels.haar import _is_wide
-from avar._kernels.streaming import _EPS, CERTIFY_TOL, certified
+from avar._kernels.streaming import _EPS, CERTIFY_TOL, certified, prefix_squares
 from avar._kernels.tasks import run_tasks
 
 #: Samples per piece: the table's granularity for the large levels and the length of a local prefix.
@@ -78,23 +77,6 @@ def local_prefix(rows, col, start, count, centre, sc, out):
     return big
 
 
-@njit(cache=True, fastmath={"reassoc", "contract"})
-def prefix_squares(p0, p1, p2, base_hi, base_lo, count):
-    """Sum over ``i < count`` of ``D_i**2``, ``D_i = base + (p2[i] - 2 p1[i] + p0[i])`` (vectorized).
-
-    Any association of the six terms is allowed (``reassoc``): :func:`difference_error_bound`
-    bounds every one of them.
-    """
-    a = p0[:count]
-    b = p1[:count]
-    c = p2[:count]
-    total = 0.0
-    for i in range(count):
-        d = (base_hi + ((c[i] - b[i]) - (b[i] - a[i]))) + base_lo
-        total += d * d
-    return total
-
-
 @njit(cache=True, inline="always")
 def prefix_error_bound(count, spread, big):
     """Bound on the error of every value of :func:`local_prefix`: ``1.01 u count (r + B)``."""
@@ -114,17 +96,17 @@ def difference_error_bound(errors, bigs, base_hi, base_lo, table_mag):
 
 
 @njit(cache=True, nogil=True)
-def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, fine, tol, out_row, marked):
+def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, fine, tol, out_row, marked, wide):
     """Adds to ``out_row`` the sums of ``D**2`` of every level over the pieces
     ``first, first + stride, ...`` (pieces of ``fine`` samples, level ``k`` its
     differences ``0 .. nd[k] - 1``) whose certificate holds, and sets ``marked[q, k]``
     for the others (:mod:`avar._kernels.far_steps` redoes them exactly).
-    ``spread[col, q]`` bounds ``|x sc - centre|`` over piece ``q``."""
+    ``spread[col, q]`` bounds ``|x sc - centre|`` over piece ``q``; ``wide``: the samples are
+    64-bit integers (not exact in one float64): every piece is marked."""
     n = rows.shape[1]
     n_levels = factors.shape[0]
     reach = 2 * (factors[n_levels - 1] // factors[0])  # farthest piece a level reads, in class steps
     ring = reach + 2  # the pieces a level reads, and the one filled ahead
-    wide = _is_wide(rows[col, 0])  # 64-bit integers: every piece exact, by its steps
     prefixes = np.empty((0 if wide else ring) * fine)  # slot s: [s fine, (s + 1) fine); 1-d, as every allocation
     errors = np.empty(ring)
     bigs = np.empty(ring)
@@ -173,11 +155,12 @@ def far_sums(rows, scale, centre, th, tl, spread, factors, nd, fine, tol=CERTIFY
     classes = int(factors[0]) // fine
     out = np.zeros((channels, classes, factors.shape[0]))
     marked = np.zeros((channels, -(-int(nd[0]) // fine), factors.shape[0]), dtype=np.bool_)
+    wide = rows.dtype.kind in "iu" and rows.dtype.itemsize == 8
 
     def task(t):
         c, a = divmod(t, classes)
         far_task(rows, c, a, classes, scale[c], centre[c], th, tl, spread, factors, nd, fine, tol, out[c, a],
-                 marked[c])
+                 marked[c], wide)
 
     run_tasks(channels * classes, task)
     result = out[:, 0].copy()

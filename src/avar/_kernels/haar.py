@@ -125,13 +125,13 @@ def _is_wide_overload(x):
     return lambda x: wide
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def block_magnitude(x, sc):
     """Largest ``|x sc|`` of a block of samples (not 64-bit integers), NaN if one is not finite."""
     return _scaled_magnitude(x, sc)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _first_level(x, sc, h, l, buffer):
     """Level 0 of a block of float64-exact samples ``x``: returns the sum of the squared
     differences of consecutive samples (each one rounding: exact up to it) and leaves the
@@ -145,7 +145,7 @@ def _first_level(x, sc, h, l, buffer):
     return _fast_sum(buffer, count - 1)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _block(rows, col, start, count, sc, h, l, buffer, levels, first_h, first_l, last_h, last_l, have, sums):
     """Pyramid of one block of ``count`` samples; updates the carried state of levels 0..P.
 

@@ -13,7 +13,9 @@ compare.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
+
+from avar._kernels.tasks import run_tasks
 
 #: Sums may be reassociated (vectorized): the statistic is a ratio compared with 0.25 and rounded.
 _FAST = {"reassoc", "contract"}
@@ -123,15 +125,17 @@ def lag1_levels(x, factors, dmax, out):
         out[i] = lag1_alpha_decimated(x, factors[i], dmax)
 
 
-@njit(cache=True, parallel=True, nogil=True)
 def lag1_levels_split(x, factors, dmax, out):
     """:func:`lag1_levels` on two threads: the first level (the longest; at the octave
     m = 1 it holds half the points) on one, the others on the other."""
-    for worker in prange(2):
-        if worker == 0:
+
+    def worker(w):
+        if w == 0:
             out[0] = lag1_alpha_decimated(x, factors[0], dmax)
         else:
             _decimating_levels(x, factors, dmax, out)
+
+    run_tasks(2, worker)
 
 
 @njit(cache=True, nogil=True)

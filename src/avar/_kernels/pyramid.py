@@ -39,10 +39,11 @@ plain two-pass kernel on the stored phase.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from avar._kernels.deviation_phase import _increment
 from avar._kernels.streaming import _two_sum
+from avar._kernels.tasks import run_tasks
 
 _NO_LO = np.zeros(1, dtype=np.float32)
 
@@ -337,35 +338,17 @@ def _phase_at(y, centre, slope, scale, stop):
     return total * scale
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def octave_moments(y, centre, slope, scale, order, n_levels, stats, tails):
-    """Moments (``stats``, shape (L, len(MOMENTS))) and small levels' clusters (``tails``,
-    shape (L, TAIL)) at m = 1, 2, ..., 2**(L - 1); ``order`` 1 for ADEV, 2 for HDEV, whose
-    sum of squares at each level is ``stats[:, SUM_COLUMN[order]]``.
-
-    Level 1 holds ``(y_i - centre - slope i) scale`` (``slope i`` exact, ``scale`` a power of two).
-    The lower levels go block by block (:func:`_stretch`); a long series runs as two
-    stretches on two threads, cut at a block boundary that depends on N alone (the bits
-    do not depend on the thread count). The upper levels run on the blocks' sums.
-    """
-    n = y.shape[0]
-    block_exp = BLOCK_EXP
-    n_blocks = -(-n >> block_exp) if n > 0 else 0
-    full = n >> block_exp
-    low = min(n_levels, block_exp)
-    sides = 2 if n_blocks >= SPLIT_BLOCKS else 1
-    cut = n_blocks // 2 if sides == 2 else n_blocks  # the right stretch starts at this block
-    z_cut = _phase_at(y, centre, slope, scale, cut << block_exp) if sides == 2 else 0.0
-    states = np.zeros((2, max(low, 1), STATE))
+@njit(cache=True, nogil=True)
+def _start_states(states, n, low, cut, block_exp, z_cut):
+    """Fresh states of the lower levels for the left stretch and for the right one (from block ``cut``)."""
     for level in range(low):
         _start(states[0, level], n >> level, 0, 0.0)
         _start(states[1, level], n >> level, cut << (block_exp - level), z_cut)
-    top_hi = np.empty(max(full, 1))
-    top_lo = np.empty(max(full, 1))
-    for side in prange(sides):
-        first = 0 if side == 0 else cut
-        stop = cut if side == 0 else n_blocks
-        _stretch(y, centre, slope, scale, order, first, stop, low, states[side], top_hi, top_lo, tails, block_exp)
+
+
+@njit(cache=True, nogil=True)
+def _finish_moments(n, low, n_levels, sides, order, full, states, top_hi, top_lo, stats, tails):
+    """The lower levels' moments from the stretches' states; the upper levels on the blocks' sums."""
     for level in range(low):
         row = stats[level]
         _moments_row(states[0, level], n >> level, row)
@@ -390,3 +373,31 @@ def octave_moments(y, centre, slope, scale, order, n_levels, stats, tails):
         _chunk_body(top_hi, top_lo, order, count, 0, state, top_hi, top_lo, tail, 0)
         _moments_row(state, count, stats[level])
         count //= 2
+
+
+def octave_moments(y, centre, slope, scale, order, n_levels, stats, tails):
+    """Moments (``stats``, shape (L, len(MOMENTS))) and small levels' clusters (``tails``,
+    shape (L, TAIL)) at m = 1, 2, ..., 2**(L - 1); ``order`` 1 for ADEV, 2 for HDEV, whose
+    sum of squares at each level is ``stats[:, SUM_COLUMN[order]]``.
+
+    Level 1 holds ``(y_i - centre - slope i) scale`` (``slope i`` exact, ``scale`` a power of two).
+    The lower levels go block by block (:func:`_stretch`); a long series runs as two
+    stretches on two threads, cut at a block boundary that depends on N alone (the bits
+    do not depend on the thread count). The upper levels run on the blocks' sums.
+    """
+    n = y.shape[0]
+    block_exp = BLOCK_EXP
+    n_blocks = -(-n >> block_exp) if n > 0 else 0
+    full = n >> block_exp
+    low = min(n_levels, block_exp)
+    sides = 2 if n_blocks >= SPLIT_BLOCKS else 1
+    cut = n_blocks // 2 if sides == 2 else n_blocks  # the right stretch starts at this block
+    z_cut = _phase_at(y, centre, slope, scale, cut << block_exp) if sides == 2 else 0.0
+    states = np.zeros((2, max(low, 1), STATE))
+    _start_states(states, n, low, cut, block_exp, z_cut)
+    top_hi = np.empty(max(full, 1))
+    top_lo = np.empty(max(full, 1))
+    run_tasks(sides, lambda side: _stretch(y, centre, slope, scale, order, 0 if side == 0 else cut,
+                                           cut if side == 0 else n_blocks, low, states[side], top_hi, top_lo, tails,
+                                           block_exp))
+    _finish_moments(n, low, n_levels, sides, order, full, states, top_hi, top_lo, stats, tails)

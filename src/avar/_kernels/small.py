@@ -22,7 +22,7 @@ import math
 import numpy as np
 from numba import njit
 
-from avar._kernels.streaming import LIMIT_EXP, certified_squares, fill_prefix
+from avar._kernels.streaming import LIMIT_EXP, certified_squares, fill_prefix, read_only
 from avar._kernels.tasks import run_tasks
 
 
@@ -116,6 +116,7 @@ def _level_task(hi, lo, factors, counts, k, is_mo, bounds, unscale, out_row):
 def small_allan_variance_parallel(data, factors, counts, is_mo, integral):
     """:func:`small_allan_variance` with the levels shared among the threads (each level's
     sum is one thread's: the bits do not depend on the thread count)."""
+    data = read_only(data)
     n, channels = data.shape
     out = np.empty((channels, factors.shape[0]))
     hi = np.empty(n + 1)

@@ -55,6 +55,15 @@ NEAR_LEN = 2 * NEAR + 4 * BLOCK
 LIMIT_EXP = 400
 
 
+def read_only(x: np.ndarray) -> np.ndarray:
+    """``x``, or a read-only view of it: numba compiles a kernel once for read-only input
+    rather than again for writable arrays of the same dtype and layout."""
+    if x.flags.writeable:
+        x = x.view()
+        x.flags.writeable = False
+    return x
+
+
 @njit(cache=True, inline="always")
 def _two_sum(a, b):
     s = a + b
@@ -308,16 +317,29 @@ _EPS = 2.0**-53
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})
-def plain_squares(h, a, m, count):
-    """Sum over ``j < count`` of ``(h[a+j+2m] - 2 h[a+j+m] + h[a+j])**2`` in plain float64 (vectorized)."""
-    x0 = h[a : a + count]
-    x1 = h[a + m : a + m + count]
-    x2 = h[a + 2 * m : a + 2 * m + count]
+def prefix_squares(p0, p1, p2, base_hi, base_lo, count):
+    """Sum over ``i < count`` of ``D_i**2``, ``D_i = base + (p2[i] - 2 p1[i] + p0[i])`` (vectorized).
+
+    Any association of the six terms is allowed (``reassoc``): the callers' error bounds
+    (:func:`avar._kernels.far.difference_error_bound`, :func:`certified_squares`) hold for
+    every one of them.
+    """
+    a = p0[:count]
+    b = p1[:count]
+    c = p2[:count]
     total = 0.0
-    for j in range(count):
-        d = (x2[j] - x1[j]) - (x1[j] - x0[j])
+    for i in range(count):
+        d = (base_hi + ((c[i] - b[i]) - (b[i] - a[i]))) + base_lo
         total += d * d
     return total
+
+
+@njit(cache=True, inline="always")
+def plain_squares(h, a, m, count):
+    """Sum over ``j < count`` of ``(h[a+j+2m] - 2 h[a+j+m] + h[a+j])**2`` in plain float64 (vectorized):
+    :func:`prefix_squares` with a zero base (the zeros add exactly; one function compiles
+    instead of two)."""
+    return prefix_squares(h[a:], h[a + m :], h[a + 2 * m :], 0.0, 0.0, count)
 
 
 @njit(cache=True, inline="always")

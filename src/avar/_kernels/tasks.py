@@ -22,7 +22,7 @@ import queue
 import threading
 from collections.abc import Callable
 
-__all__ = ["run_tasks", "threads"]
+__all__ = ["run_ranges", "run_tasks", "threads"]
 
 #: Jobs for the helper threads: each takes tasks of one :func:`run_tasks` call until none is left.
 _JOBS: queue.SimpleQueue = queue.SimpleQueue()
@@ -113,3 +113,25 @@ def run_tasks(n_tasks: int, task: Callable[[int], object]) -> None:
         _JOBS.put(call.work)
     call.work()
     call.wait()
+
+
+#: Parts per thread of :func:`run_ranges` (more parts balance uneven items better).
+PARTS_PER_THREAD = 4
+
+
+def run_ranges(n_items: int, work: Callable[[int, int], object]) -> None:
+    """Call ``work(first, stop)`` on consecutive ranges covering ``range(n_items)``, on the threads.
+
+    For many small independent items (each writes its own slot): one kernel call per
+    range rather than per item. The ranges depend on the thread count, so ``work`` must
+    not make an item's result depend on its range.
+
+    >>> seen = []
+    >>> run_ranges(10, lambda first, stop: seen.extend(range(first, stop)))
+    >>> sorted(seen) == list(range(10))
+    True
+    """
+    n_items = int(n_items)
+    parts = max(1, min(n_items, PARTS_PER_THREAD * threads()))
+    bounds = [n_items * p // parts for p in range(parts + 1)]
+    run_tasks(parts, lambda p: work(bounds[p], bounds[p + 1]))
