@@ -314,7 +314,8 @@ def covariance_pass(c, width, noav_ns, noav_scan, noav_width, tile=COV_TILE):
                                         acc, f, pre))
     n = noav_ns.shape[0]
     noav = acc[0, :n] + acc[1, :n]
-    out = sums[0][[0, 3, 4, 5], :width] + sums[1][[0, 3, 4, 5], :width]
+    with np.errstate(over="ignore", invalid="ignore"):  # as in compiled code: an overflow is inf, caught later
+        out = sums[0][[0, 3, 4, 5], :width] + sums[1][[0, 3, 4, 5], :width]
     return float(max(asym[0], asym[1])), int(max(top[0], top[1])), beta, out[0], out[1], out[2], out[3], noav
 
 
