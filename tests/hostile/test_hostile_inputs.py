@@ -18,10 +18,10 @@ X = RNG.standard_normal(3000)
 
 
 # --------------------------------------------------------------------------- files
-def test_a_10000_column_header_is_read_whole_through_the_cli(tmp_path, capsys):
-    """The header is 118 KB, beyond the 64 KiB sniffed: no column may be lost or mislabelled."""
-    names = [f"channel_{i:05d}" for i in range(10_000)]
-    values = np.random.default_rng(1).standard_normal((8, 10_000)).round(4)
+def test_a_100_kb_header_is_read_whole_through_the_cli(tmp_path, capsys):
+    """The header is 108 KB, beyond the 64 KiB sniffed: no column may be lost or mislabelled."""
+    names = [f"gyroscope_channel_number_{i:05d}" for i in range(3_500)]
+    values = np.random.default_rng(1).standard_normal((8, len(names))).round(4)
     path = tmp_path / "wide.csv"
     pd.DataFrame(values, columns=names).to_csv(path, index=False)
     code, _, err = cli(capsys, "compute", path, "--taus", "all", "--output", tmp_path / "o.csv")

@@ -155,10 +155,12 @@ def test_small_path_matches_loop_on_every_scale(type):
 
 @pytest.mark.parametrize("n", [5, 300, 40_000, 300_000])  # small path, on threads, sweep / pyramid / levels
 @pytest.mark.parametrize("type", ["mo", "to"])
-def test_non_finite_values_are_found_by_the_kernel_pass(type, n):
+def test_non_finite_values_are_found_by_the_kernel_pass(type, n, monkeypatch):
     """No up-front scan: a NaN or infinity anywhere (also in a tail no "to" cluster covers)
     makes the kernels' centre non-finite, and the error names its index, on every path."""
     import avar
+
+    monkeypatch.setattr(columns, "SMALL_MO_MAX", 1 << 18)  # 300,000 samples take the sweep and levels
 
     for taus in ("octave", [2.0] if n < 10 else [3.0, 6.0, 7.0]):
         for position in (0, n // 2, n - 1):

@@ -25,16 +25,17 @@ NOTICE_START = "avar: compiling the numerical kernels"
 QUIET_THREADS = frozenset({"avar-warm-up"})
 
 #: Rough compile time of each subcommand's kernels on one idle core, seconds: the CPU time
-#: of a cold run less a warm one in benchmarks/bench_cli_startup.py (demo 7.5 s, report of
-#: a 2 h 200 Hz 6-axis log 27 s); compute and fit of a long file compile the same kernels.
-COMPILE_SECONDS = {"demo": 10, "compute": 30, "fit": 30, "report": 30}
+#: of a cold run less a warm one in benchmarks/bench_cli_startup.py (demo 3.9 s, report of
+#: a 2 h 200 Hz 6-axis log 3.7 s); compute and fit of a log beyond 2**22 samples also
+#: compile the streaming sweep (about 5 s more).
+COMPILE_SECONDS = {"demo": 5, "compute": 10, "fit": 10, "report": 5}
 
 
 def notice_text(command: str) -> str:
     """The one line printed when the first kernel of ``command`` compiles.
 
     >>> print(notice_text("report"))  # doctest: +ELLIPSIS
-    avar: compiling the numerical kernels for this machine (first run only; up to about 30 s); later runs load them ...
+    avar: compiling the numerical kernels for this machine (first run only; up to about 5 s); later runs load them ...
     """
     seconds = COMPILE_SECONDS.get(command, 10)
     where = os.environ.get("NUMBA_CACHE_DIR")
