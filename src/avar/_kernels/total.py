@@ -24,6 +24,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from avar._kernels.total_blocks import level_sum
+
 
 @njit(cache=True)
 def _clean(bad: np.ndarray, shift: int, start: int, stop: int) -> bool:
@@ -172,9 +174,17 @@ def _level_parallel(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shif
 PARALLEL_WORK = 1 << 24
 
 
+#: MTOTDEV and HTOTDEV levels of gap-free data with n_terms (m + 10) above this take the
+#: blocked O(N) expansion of :mod:`avar._kernels.total_blocks`; smaller ones the direct loop,
+#: which is cheaper there (the expansion costs ~1 ms of tables per level).
+FAST_WORK = 1 << 15
+
+
 def _level(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, n_terms: int) -> tuple[float, int]:
     """One level's sum over its ``n_terms`` terms, in tasks of :data:`CHUNK` summed in order
     (serially for small levels: threads cost more than they save there)."""
+    if kind < 2 and bad.shape[0] == 0 and n_terms > 0 and n_terms * (m + 10) > FAST_WORK:
+        return level_sum(values, m), n_terms
     work = n_terms * m * (1 if kind == 2 else 3)
     if work > PARALLEL_WORK and n_terms > CHUNK:
         return _level_parallel(kind, values, m, bad, shift, n_terms)

@@ -44,7 +44,6 @@ the tests check the expansion against the direct kernel and a plain loop.
 
 from __future__ import annotations
 
-from fractions import Fraction
 from functools import lru_cache
 
 import numpy as np
@@ -71,31 +70,27 @@ def _terms(sixth: int, m: int) -> list[tuple[int, int, int]]:
 
 
 def _power_sums(m: int) -> list[int]:
-    """sum_{j=0}^{m-1} j^p, p = 0 .. 4, exactly."""
-    return [sum(j**p for j in range(m)) if m < 64 else _faulhaber(m, p) for p in range(5)]
-
-
-def _faulhaber(m: int, p: int) -> int:
+    """sum_{j=0}^{m-1} j^p, p = 0 .. 4, exactly (Faulhaber)."""
     n = m - 1
-    return [n + 1, n * (n + 1) // 2, n * (n + 1) * (2 * n + 1) // 6, (n * (n + 1) // 2) ** 2,
-            n * (n + 1) * (2 * n + 1) * (3 * n * n + 3 * n - 1) // 30][p]
+    return [m, n * m // 2, n * m * (2 * n + 1) // 6, (n * m // 2) ** 2,
+            n * m * (2 * n + 1) * (3 * n * n + 3 * n - 1) // 30]
 
 
-@lru_cache(maxsize=256)
+@lru_cache(maxsize=1024)
 def level_tables(m: int) -> tuple[np.ndarray, ...]:
-    """The expansion of one level (see the module docstring), all integers:
+    """The expansion of one level (see the module docstring), from exact integers:
 
     ``same`` rows (lag / m, first position, weight): sum_n sum_{u<m} X(n + lo + u) X(n + lo + u + lag);
-    ``opposite`` rows (b, b', weight): sum_n sum_{j'<m} X(n + b + j') X(n + b' - j');
-    ``forward[xi, i, p]`` and ``backward[xi, i, p]``: weights of sum_u u^p X(n + i m + u) over
-    u = 0 .. m - 1 and u = 1 .. m in sum_j' U pi_xi (xi = X(n), mu, s);
+    ``pairs[b / m, b' / m - 1]``: the weight of sum_n sum_{j'<m} X(n + b + j') X(n + b' - j');
+    ``cross[xi, i, p]`` and ``points[xi, q]``: sum_j' U pi_xi (xi = X(n), mu, s) is
+    sum_{i,p} cross[xi, i, p] sum_{u<m} u^p X(n + i m + u) + sum_q points[xi, q] X(n + q m);
     ``square[xi, xi']`` = sum_{sixths} sum_j' pi_xi pi_xi'.
     """
     same: dict[tuple[int, int], int] = {}
-    opposite: dict[tuple[int, int], int] = {}
-    forward = [[[Fraction(0)] * 3 for _ in range(3)] for _ in range(3)]
-    backward = [[[Fraction(0)] * 3 for _ in range(3)] for _ in range(3)]
-    square = [[Fraction(0)] * 3 for _ in range(3)]
+    pairs = np.zeros((3, 3))
+    forward = np.zeros((3, 3, 3), dtype=object)  # 2 x the weights of u^p, u = 0 .. m - 1
+    backward = np.zeros((3, 3, 3), dtype=object)  # 2 x the weights of u^p, u = 1 .. m
+    square = np.zeros((3, 3), dtype=object)  # 4 x
     power = _power_sums(m)
     for sixth in range(6):
         terms = _terms(sixth, m)
@@ -105,65 +100,41 @@ def level_tables(m: int) -> tuple[np.ndarray, ...]:
                     lo_a, lo_b = (ba, bb) if da == 1 else (ba - m + 1, bb - m + 1)
                     key = ((abs(lo_b - lo_a)) // m, min(lo_a, lo_b))
                     same[key] = same.get(key, 0) + ga * gb
-                elif da == 1:
-                    opposite[(ba, bb)] = opposite.get((ba, bb), 0) + ga * gb
                 else:
-                    opposite[(bb, ba)] = opposite.get((bb, ba), 0) + ga * gb
-        # P_j = X(n) pi_X + mu pi_mu(j') + s pi_s(j'), coefficients of 1, j', j'^2
-        pis = [[-sum(g for g, _, _ in terms), Fraction(0), Fraction(0)],
-               [-sum(g * b for g, b, _ in terms), -sum(g * d for g, _, d in terms), Fraction(0)],
-               [-sum(Fraction(g * (b * b - b), 2) for g, b, _ in terms),
-                -sum(Fraction(g * (2 * b - 1) * d, 2) for g, b, d in terms),
-                -sum(Fraction(g, 2) for g, _, _ in terms)]]
-        pis = [[Fraction(c) for c in pi] for pi in pis]
+                    b, c = (ba, bb) if da == 1 else (bb, ba)
+                    pairs[b // m, c // m - 1] += ga * gb
+        # 2 P_j = X(n) pi_X + mu pi_mu(j') + s pi_s(j'), coefficients of 1, j', j'^2 (doubled)
+        pis = [(-2 * sum(g for g, _, _ in terms), 0, 0),
+               (-2 * sum(g * b for g, b, _ in terms), -2 * sum(g * d for g, _, d in terms), 0),
+               (-sum(g * (b * b - b) for g, b, _ in terms), -sum(g * (2 * b - 1) * d for g, b, d in terms),
+                -sum(g for g, _, _ in terms))]
         for g, b, d in terms:
             for xi, (q0, q1, q2) in enumerate(pis):
                 if d == 1:  # positions b + u, u = j'
-                    row = forward[xi][b // m]
-                    coefs = (q0, q1, q2)
+                    forward[xi, b // m] += (g * q0, g * q1, g * q2)
                 else:  # positions b - j' = (b - m) + u, u = m - j' = 1 .. m
-                    row = backward[xi][b // m - 1]
-                    coefs = (q0 + q1 * m + q2 * m * m, -q1 - 2 * q2 * m, q2)
-                for p in range(3):
-                    row[p] += g * coefs[p]
+                    backward[xi, b // m - 1] += (g * (q0 + q1 * m + q2 * m * m), -g * (q1 + 2 * q2 * m), g * q2)
         for a in range(3):
             for c in range(3):
-                square[a][c] += sum(pis[a][p] * pis[c][q] * power[p + q] for p in range(3) for q in range(3))
+                square[a, c] += sum(pis[a][p] * pis[c][q] * power[p + q] for p in range(3) for q in range(3))
     same_rows = np.array([(lag, lo, w) for (lag, lo), w in sorted(same.items()) if w], dtype=np.int64)
-    opposite_rows = np.array([(b, c, w) for (b, c), w in sorted(opposite.items()) if w], dtype=np.int64)
     assert same_rows[:, 0].max() <= 2
-    return (same_rows, opposite_rows, np.array(forward, dtype=np.float64), np.array(backward, dtype=np.float64),
-            np.array(square, dtype=np.float64))
+    # sum_{u=1}^{m} u^p X(o + u) = sum_{u=0}^{m-1} u^p X(o + u) + m^p X(o + m) - [p = 0] X(o)
+    cross = (forward + backward).astype(np.float64) / 2.0
+    points = np.zeros((3, 4))
+    for xi in range(3):
+        for i in range(3):
+            q0, q1, q2 = backward[xi, i]
+            points[xi, i] -= q0 / 2
+            points[xi, i + 1] += (q0 + q1 * m + q2 * m * m) / 2
+    return same_rows, pairs, cross, points, square.astype(np.float64) / 4.0
 
 
 @njit(cache=True, nogil=True)
-def _block(values, n0, count, m, same, opposite, forward, backward, square, x, weights, parity, moments):
-    """sum of Q(n) over the windows n0 .. n0 + count - 1 (see the module docstring)."""
-    span = 3 * m
-    npts = count + span - 1
-    # least-squares line of the block's values, in local time
-    centre = 0.5 * (npts - 1)
-    mean = 0.0
-    for t in range(npts):
-        mean += values[n0 + t]
-    mean /= npts
-    num = 0.0
-    den = 0.0
-    for t in range(npts):
-        dt = t - centre
-        num += dt * (values[n0 + t] - mean)
-        den += dt * dt
-    slope = num / den if den > 0.0 else 0.0
-    nx = npts + 1
-    x[0] = 0.0
-    for t in range(npts):
-        x[t + 1] = x[t] + ((values[n0 + t] - mean) - slope * (t - centre))
-    for t in range(nx, nx + 2 * m + 1):
-        x[t] = 0.0
-    # 1. same direction: integer trapezoid weights per lag, one pass
-    for lag in range(3):
-        for t in range(nx + m + 2):
-            weights[lag, t] = 0.0
+def _trapezoids(same, m, count, weights):
+    """weights[lag, t] = the sum over the ``same`` rows (lag, lo, w) of w times the number of
+    (n, u), n < count, u < m, with n + lo + u = t: a double running sum of four spikes per row."""
+    weights[:, :] = 0.0
     for r in range(same.shape[0]):
         lag, lo, w = same[r, 0], same[r, 1], float(same[r, 2])
         weights[lag, lo] += w
@@ -173,60 +144,100 @@ def _block(values, n0, count, m, same, opposite, forward, backward, square, x, w
     for lag in range(3):
         run = 0.0
         acc = 0.0
-        for t in range(nx + m + 2):
+        for t in range(weights.shape[1]):
             run += weights[lag, t]
             acc += run
             weights[lag, t] = acc
+
+
+@njit(cache=True, nogil=True)
+def _prepare(values, n0, npts, x, parity, moments):
+    """The block's local running sum x (its values less a line; any line would do, this one is
+    close to the least-squares line in local time t), its running sums over each parity,
+    parity[t + 2] = x[t] + parity[t], and moments[p, t + 1] = sum_{t' <= t} t'^p x[t']."""
+    centre = 0.5 * (npts - 1)
+    level = 0.0
+    tilt = 0.0
+    for t in range(npts):
+        v = values[n0 + t]
+        level += v
+        tilt += (t - centre) * v
+    level /= npts
+    tilt /= npts * (npts * npts - 1.0) / 12.0
+    parity[0] = 0.0
+    parity[1] = 0.0
+    moments[0, 0] = 0.0
+    moments[1, 0] = 0.0
+    moments[2, 0] = 0.0
+    acc = 0.0
+    for t in range(npts + 1):
+        x[t] = acc
+        parity[t + 2] = acc + parity[t]
+        moments[0, t + 1] = moments[0, t] + acc
+        moments[1, t + 1] = moments[1, t] + t * acc
+        moments[2, t + 1] = moments[2, t] + (t * t) * acc
+        if t < npts:
+            acc += (values[n0 + t] - level) - tilt * (t - centre)
+
+
+@njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
+def _same(x, weights, nx, m):
+    """1. sum_t x[t] (w0[t] x[t] + w1[t] x[t + m] + w2[t] x[t + 2m])."""
     total = 0.0
     for t in range(nx):
         total += x[t] * (weights[0, t] * x[t] + weights[1, t] * x[t + m] + weights[2, t] * x[t + 2 * m])
-    # 2. opposite directions: running sums over each parity, parity[t + 2] = x[t] + parity[t]
-    parity[0] = 0.0
-    parity[1] = 0.0
-    for t in range(nx):
-        parity[t + 2] = x[t] + parity[t]
-    for r in range(opposite.shape[0]):
-        bf, br, w = opposite[r, 0], opposite[r, 1], float(opposite[r, 2])
-        acc = 0.0
-        for run in range(count + m - 1):  # run = n + j', u = bf + run, v = br + run - 2 j'
-            jlo = max(0, run - count + 1)
-            jhi = min(m - 1, run)
-            acc += x[bf + run] * (parity[br + run - 2 * jlo + 2] - parity[br + run - 2 * jhi])
-        total += w * acc
-    # 3. and 4. per window: the pieces' moments and the scalars
-    for t in range(nx):
-        moments[0, t + 1] = moments[0, t] + x[t]
-        moments[1, t + 1] = moments[1, t] + t * x[t]
-        moments[2, t + 1] = moments[2, t] + (t * t) * x[t]
+    return total
+
+
+@njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
+def _opposite(x, parity, pairs, count, m):
+    """2. sum_{b, b'} pairs[b, b'] sum_n sum_j' x[n + b m + j'] x[n + (b' + 1) m - j']: for
+    run = n + j' the partners x[(b' + 1) m + run - 2 j'], j' = jlo .. jhi, are read from ``parity``."""
+    o00, o01, o02 = pairs[0, 0], pairs[0, 1], pairs[0, 2]
+    o10, o11, o12 = pairs[1, 0], pairs[1, 1], pairs[1, 2]
+    o20, o21, o22 = pairs[2, 0], pairs[2, 1], pairs[2, 2]
+    total = 0.0
+    for run in range(count + m - 1):
+        jlo = max(0, run - count + 1)
+        jhi = min(m - 1, run)
+        hi = run - 2 * jlo + 2
+        lo = run - 2 * jhi
+        s1 = parity[m + hi] - parity[m + lo]
+        s2 = parity[2 * m + hi] - parity[2 * m + lo]
+        s3 = parity[3 * m + hi] - parity[3 * m + lo]
+        total += (x[run] * (o00 * s1 + o01 * s2 + o02 * s3) + x[m + run] * (o10 * s1 + o11 * s2 + o12 * s3)
+                  + x[2 * m + run] * (o20 * s1 + o21 * s2 + o22 * s3))
+    return total
+
+
+@njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
+def _windows(x, moments, cross, points, square, count, m):
+    """3. and 4.: sum_n 2 sum_j' U P + sum_j' P^2, from the pieces' moments and the scalars."""
+    span = 3 * m
     half = span // 2
     gap = span - half
     tail = span * (span - 1) / 2.0
-    mm = float(m) * m
+    total = 0.0
     for n in range(count):
         x0 = x[n]
-        s = ((x[n + span] - x[n + gap]) - (x[n + half] - x0)) / half / gap
-        mu = ((x[n + span] - x0) - s * tail) / span
-        c0 = 0.0
-        c1 = 0.0
-        c2 = 0.0
+        x1 = x[n + m]
+        x2 = x[n + 2 * m]
+        x3 = x[n + span]
+        s = ((x3 - x[n + gap]) - (x[n + half] - x0)) / half / gap
+        mu = ((x3 - x0) - s * tail) / span
+        c0 = points[0, 0] * x0 + points[0, 1] * x1 + points[0, 2] * x2 + points[0, 3] * x3
+        c1 = points[1, 0] * x0 + points[1, 1] * x1 + points[1, 2] * x2 + points[1, 3] * x3
+        c2 = points[2, 0] * x0 + points[2, 1] * x1 + points[2, 2] * x2 + points[2, 3] * x3
         for i in range(3):
             o = n + i * m
             d0 = moments[0, o + m] - moments[0, o]
             d1 = moments[1, o + m] - moments[1, o]
             d2 = moments[2, o + m] - moments[2, o]
-            f0 = d0
             f1 = d1 - o * d0
             f2 = d2 - o * (2.0 * d1 - o * d0)
-            end = x[o + m]
-            b0 = f0 - x[o] + end
-            b1 = f1 + m * end
-            b2 = f2 + mm * end
-            c0 += (forward[0, i, 0] * f0 + forward[0, i, 1] * f1 + forward[0, i, 2] * f2
-                   + backward[0, i, 0] * b0 + backward[0, i, 1] * b1 + backward[0, i, 2] * b2)
-            c1 += (forward[1, i, 0] * f0 + forward[1, i, 1] * f1 + forward[1, i, 2] * f2
-                   + backward[1, i, 0] * b0 + backward[1, i, 1] * b1 + backward[1, i, 2] * b2)
-            c2 += (forward[2, i, 0] * f0 + forward[2, i, 1] * f1 + forward[2, i, 2] * f2
-                   + backward[2, i, 0] * b0 + backward[2, i, 1] * b1 + backward[2, i, 2] * b2)
+            c0 += cross[0, i, 0] * d0 + cross[0, i, 1] * f1 + cross[0, i, 2] * f2
+            c1 += cross[1, i, 0] * d0 + cross[1, i, 1] * f1 + cross[1, i, 2] * f2
+            c2 += cross[2, i, 0] * d0 + cross[2, i, 1] * f1 + cross[2, i, 2] * f2
         total += 2.0 * (x0 * c0 + mu * c1 + s * c2)
         total += (x0 * (square[0, 0] * x0 + 2.0 * (square[0, 1] * mu + square[0, 2] * s))
                   + mu * (square[1, 1] * mu + 2.0 * square[1, 2] * s) + square[2, 2] * s * s)
@@ -234,20 +245,27 @@ def _block(values, n0, count, m, same, opposite, forward, backward, square, x, w
 
 
 @njit(cache=True, nogil=True)
-def _blocks(values, m, n_terms, size, first, stop, same, opposite, forward, backward, square, out):
+def _blocks(values, m, n_terms, size, first, stop, same, opposite, cross, points, square, out):
     """out[b] = the sum of Q(n) / (6 m^3) over the windows of block b, for b = first .. stop - 1."""
     span = 3 * m
     length = size + span + 2 * m + 4
     x = np.empty(length)
     weights = np.empty((3, length))
     parity = np.empty(length + 2)
-    moments = np.zeros((3, length))
+    moments = np.empty((3, length + 1))
     scale = 6.0 * m * m * m
+    made = -1
     for b in range(first, stop):
         n0 = b * size
         count = min(size, n_terms - n0)
-        out[b] = _block(values, n0, count, m, same, opposite, forward, backward, square, x, weights, parity,
-                        moments) / scale
+        if count != made:
+            _trapezoids(same, m, count, weights)
+            made = count
+        nx = count + span
+        _prepare(values, n0, nx - 1, x, parity, moments)
+        x[nx : nx + 2 * m + 1] = 0.0
+        out[b] = (_same(x, weights, nx, m) + _opposite(x, parity, opposite, count, m)
+                  + _windows(x, moments, cross, points, square, count, m)) / scale
 
 
 #: Windows per block, in units of m: each block reads (BLOCK + 3) m values.
