@@ -127,6 +127,7 @@ def level_tables(m: int) -> tuple[np.ndarray, ...]:
             q0, q1, q2 = backward[xi, i]
             points[xi, i] -= q0 / 2
             points[xi, i + 1] += (q0 + q1 * m + q2 * m * m) / 2
+    assert not cross[:2, :, 1:].any()  # pi_X and pi_mu do not depend on j'
     return same_rows, pairs, cross, points, square.astype(np.float64) / 4.0
 
 
@@ -151,10 +152,10 @@ def _trapezoids(same, m, count, weights):
 
 
 @njit(cache=True, nogil=True)
-def _prepare(values, n0, npts, x, parity, moments):
+def _prepare(values, n0, npts, x, parity):
     """The block's local running sum x (its values less a line; any line would do, this one is
-    close to the least-squares line in local time t), its running sums over each parity,
-    parity[t + 2] = x[t] + parity[t], and moments[p, t + 1] = sum_{t' <= t} t'^p x[t']."""
+    close to the least-squares line in local time t) and its running sums over each parity,
+    parity[t + 2] = x[t] + parity[t]."""
     centre = 0.5 * (npts - 1)
     level = 0.0
     tilt = 0.0
@@ -166,16 +167,10 @@ def _prepare(values, n0, npts, x, parity, moments):
     tilt /= npts * (npts * npts - 1.0) / 12.0
     parity[0] = 0.0
     parity[1] = 0.0
-    moments[0, 0] = 0.0
-    moments[1, 0] = 0.0
-    moments[2, 0] = 0.0
     acc = 0.0
     for t in range(npts + 1):
         x[t] = acc
         parity[t + 2] = acc + parity[t]
-        moments[0, t + 1] = moments[0, t] + acc
-        moments[1, t + 1] = moments[1, t] + t * acc
-        moments[2, t + 1] = moments[2, t] + (t * t) * acc
         if t < npts:
             acc += (values[n0 + t] - level) - tilt * (t - centre)
 
@@ -210,13 +205,29 @@ def _opposite(x, parity, pairs, count, m):
     return total
 
 
-@njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
-def _windows(x, moments, cross, points, square, count, m):
-    """3. and 4.: sum_n 2 sum_j' U P + sum_j' P^2, from the pieces' moments and the scalars."""
+@njit(cache=True, nogil=True)
+def _windows(x, cross, points, square, count, m):
+    """3. and 4.: sum_n 2 sum_j' U P + sum_j' P^2, from the scalars and the pieces' moments
+    f_{i,p}(n) = sum_{u<m} u^p x[n + i m + u], slid from n to n + 1 (exact recurrences)."""
     span = 3 * m
     half = span // 2
     gap = span - half
     tail = span * (span - 1) / 2.0
+    f = np.zeros((3, 3))
+    for i in range(3):
+        for u in range(m):
+            xu = x[i * m + u]
+            f[i, 0] += xu
+            f[i, 1] += u * xu
+            f[i, 2] += (u * u) * xu
+    f00, f01, f02 = f[0, 0], f[0, 1], f[0, 2]
+    f10, f11, f12 = f[1, 0], f[1, 1], f[1, 2]
+    f20, f21, f22 = f[2, 0], f[2, 1], f[2, 2]
+    a00, a01, a02 = cross[0, 0, 0], cross[0, 1, 0], cross[0, 2, 0]
+    a10, a11, a12 = cross[1, 0, 0], cross[1, 1, 0], cross[1, 2, 0]
+    c2 = cross[2]
+    last = m - 1.0
+    last2 = last * last
     total = 0.0
     for n in range(count):
         x0 = x[n]
@@ -225,22 +236,26 @@ def _windows(x, moments, cross, points, square, count, m):
         x3 = x[n + span]
         s = ((x3 - x[n + gap]) - (x[n + half] - x0)) / half / gap
         mu = ((x3 - x0) - s * tail) / span
-        c0 = points[0, 0] * x0 + points[0, 1] * x1 + points[0, 2] * x2 + points[0, 3] * x3
-        c1 = points[1, 0] * x0 + points[1, 1] * x1 + points[1, 2] * x2 + points[1, 3] * x3
-        c2 = points[2, 0] * x0 + points[2, 1] * x1 + points[2, 2] * x2 + points[2, 3] * x3
-        for i in range(3):
-            o = n + i * m
-            d0 = moments[0, o + m] - moments[0, o]
-            d1 = moments[1, o + m] - moments[1, o]
-            d2 = moments[2, o + m] - moments[2, o]
-            f1 = d1 - o * d0
-            f2 = d2 - o * (2.0 * d1 - o * d0)
-            c0 += cross[0, i, 0] * d0 + cross[0, i, 1] * f1 + cross[0, i, 2] * f2
-            c1 += cross[1, i, 0] * d0 + cross[1, i, 1] * f1 + cross[1, i, 2] * f2
-            c2 += cross[2, i, 0] * d0 + cross[2, i, 1] * f1 + cross[2, i, 2] * f2
-        total += 2.0 * (x0 * c0 + mu * c1 + s * c2)
+        k0 = points[0, 0] * x0 + points[0, 1] * x1 + points[0, 2] * x2 + points[0, 3] * x3
+        k1 = points[1, 0] * x0 + points[1, 1] * x1 + points[1, 2] * x2 + points[1, 3] * x3
+        k2 = points[2, 0] * x0 + points[2, 1] * x1 + points[2, 2] * x2 + points[2, 3] * x3
+        k0 += a00 * f00 + a01 * f10 + a02 * f20
+        k1 += a10 * f00 + a11 * f10 + a12 * f20
+        k2 += (c2[0, 0] * f00 + c2[0, 1] * f01 + c2[0, 2] * f02 + c2[1, 0] * f10 + c2[1, 1] * f11
+               + c2[1, 2] * f12 + c2[2, 0] * f20 + c2[2, 1] * f21 + c2[2, 2] * f22)
+        total += 2.0 * (x0 * k0 + mu * k1 + s * k2)
         total += (x0 * (square[0, 0] * x0 + 2.0 * (square[0, 1] * mu + square[0, 2] * s))
                   + mu * (square[1, 1] * mu + 2.0 * square[1, 2] * s) + square[2, 2] * s * s)
+        # sum_{u<m} u^p x[o + 1 + u] from the sums at o (the new term x[o + m], the old x[o])
+        f02 = f02 - 2.0 * f01 + f00 + last2 * x1 - x0
+        f01 = f01 - f00 + last * x1 + x0
+        f00 = f00 + x1 - x0
+        f12 = f12 - 2.0 * f11 + f10 + last2 * x2 - x1
+        f11 = f11 - f10 + last * x2 + x1
+        f10 = f10 + x2 - x1
+        f22 = f22 - 2.0 * f21 + f20 + last2 * x3 - x2
+        f21 = f21 - f20 + last * x3 + x2
+        f20 = f20 + x3 - x2
     return total
 
 
@@ -252,7 +267,6 @@ def _blocks(values, m, n_terms, size, first, stop, same, opposite, cross, points
     x = np.empty(length)
     weights = np.empty((3, length))
     parity = np.empty(length + 2)
-    moments = np.empty((3, length + 1))
     scale = 6.0 * m * m * m
     made = -1
     for b in range(first, stop):
@@ -262,10 +276,10 @@ def _blocks(values, m, n_terms, size, first, stop, same, opposite, cross, points
             _trapezoids(same, m, count, weights)
             made = count
         nx = count + span
-        _prepare(values, n0, nx - 1, x, parity, moments)
+        _prepare(values, n0, nx - 1, x, parity)
         x[nx : nx + 2 * m + 1] = 0.0
         out[b] = (_same(x, weights, nx, m) + _opposite(x, parity, opposite, count, m)
-                  + _windows(x, moments, cross, points, square, count, m)) / scale
+                  + _windows(x, cross, points, square, count, m)) / scale
 
 
 #: Windows per block, in units of m: each block reads (BLOCK + 3) m values.
