@@ -1,0 +1,104 @@
+"""The blocked O(N) expansion of MTOTDEV and HTOTDEV against the direct O(N m) kernel and the exact formula."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from powerlaw import powerlaw_phase
+
+import avar
+from avar._kernels import tasks, total
+from avar._kernels.total_blocks import block_size, level_sum, level_tables
+
+NO_GAPS = np.zeros(0, dtype=np.int64)
+
+
+def direct(values: np.ndarray, m: int) -> float:
+    """The direct kernel's level sum (kind 0 and 1 differ only in how gaps are read)."""
+    return total._level_serial(0, values, m, NO_GAPS, 0, values.shape[0] - 3 * m + 1)[0]
+
+
+def exact_level(values: list, m: int) -> Fraction:
+    """sum_n (1 / 6m^3) sum_j (A_j - 2 B_j + C_j)^2 over the detrended, reflected windows, exactly."""
+    span, half = 3 * m, 3 * m // 2
+    total_sum = Fraction(0)
+    for n in range(len(values) - span + 1):
+        w = values[n : n + span]
+        slope = (sum(w[span - half :]) - sum(w[:half])) / half / (span - half)
+        w = [w[k] - slope * k for k in range(span)]
+        star = w[::-1] + w + w[::-1]
+        for j in range(6 * m):
+            total_sum += (sum(star[j : j + m]) - 2 * sum(star[j + m : j + 2 * m]) + sum(star[j + 2 * m : j + 3 * m])) ** 2
+    return total_sum / (6 * m**3)
+
+
+#: Phase of white PM, flicker PM, flicker FM and random-walk FM (FFT-filtered white noise), and
+#: their frequencies (HTOTDEV's values).
+N = 3000
+SERIES = {alpha: powerlaw_phase(N, alpha, seed=40 + alpha) for alpha in (2, 1, -1, -2)}
+
+
+@pytest.mark.parametrize("m", [1, 2, 3, 4, 7, 8, 33, 120, 333, 999, 1000])
+@pytest.mark.parametrize("alpha", [2, 1, -1, -2])
+def test_equals_the_direct_kernel(m, alpha):
+    """MTOTDEV (phase) and HTOTDEV (frequency) levels, odd and even 3m, up to m = N / 3; the last
+    block is short unless the number of windows is a multiple of the block size."""
+    for values in (SERIES[alpha], np.diff(SERIES[alpha])):
+        if 3 * m > values.size:
+            continue
+        assert level_sum(values, m) == pytest.approx(direct(values, m), rel=1e-11)
+
+
+def test_long_series_several_blocks_per_level():
+    x = powerlaw_phase(20000, -2, seed=3)
+    for m in (5, 64, 700):
+        assert (x.size - 3 * m + 1) > 4 * block_size(m)
+        assert level_sum(x, m) == pytest.approx(direct(x, m), rel=1e-11)
+
+
+def test_equals_the_exact_formula():
+    x = np.cumsum(np.random.default_rng(5).standard_normal(50))
+    for m in (1, 2, 5):
+        assert level_sum(x, m) == pytest.approx(float(exact_level([Fraction(float(v)) for v in x], m)), rel=1e-12)
+
+
+def test_blind_to_a_line_and_to_the_thread_count(monkeypatch):
+    x = SERIES[-1]
+    shifted = x + 3.0 - 0.01 * np.arange(N)
+    assert level_sum(shifted, 40) == pytest.approx(level_sum(x, 40), rel=1e-10)
+    sums = []
+    for count in (1, 3):
+        monkeypatch.setattr(tasks, "threads", lambda count=count: count)
+        sums.append(level_sum(x, 7))
+    assert sums[0] == sums[1]  # each block's sum has its own slot, added in order
+
+
+def test_tables_are_exact_integers():
+    for m in (1, 4, 33, 1 << 18):
+        same, pairs, cross, points, square = level_tables(m)
+        assert same[:, 0].max() <= 2 and np.all(pairs == np.round(pairs))
+        for table in (cross, points, square):
+            assert np.all(table * 4 == np.round(table * 4))  # halves and quarters of integers
+
+
+def test_levels_choose_their_path(monkeypatch):
+    """Gap-free levels with enough work take the expansion; levels with gaps the direct kernel."""
+    calls = []
+    monkeypatch.setattr(total, "level_sum", lambda values, m: calls.append(m) or 0.0)
+    x = SERIES[-1]
+    assert (N - 2) * (1 + 10) > total.FAST_WORK  # m = 1 at N = 3000: just above the switch-over
+    total.level_sums(0, x, np.array([1, 64]), NO_GAPS, 0)
+    total.level_sums(1, x[:40], np.array([2]), NO_GAPS, 0)  # below it: too small to pay for the tables
+    assert calls == [1, 64]
+    holed = x.copy()
+    holed[100] = np.nan
+    res = avar.mtotdev(holed, data_type="phase", taus=[64.0], nan_policy="omit")
+    assert calls == [1, 64] and res.n[0] < N - 3 * 64 + 1
+    calls.clear()
+    monkeypatch.undo()
+    a = avar.htotdev(x, data_type="phase", taus=[64.0], bias_correction=False)
+    monkeypatch.setattr(total, "FAST_WORK", 1 << 60)
+    b = avar.htotdev(x, data_type="phase", taus=[64.0], bias_correction=False)
+    assert a.deviation[0] == pytest.approx(b.deviation[0], rel=1e-11)
