@@ -11,12 +11,20 @@ the input + 1; empty when there is none) and ``shift`` is 0 for phase data
 ``x[k + 1] - x[k]`` is missing). A term whose phase points ``start .. stop - 1``
 touch a gap is skipped; the kernels return the sum and the number of terms used.
 
-Each window of the total statistics is detrended and summed through the running
-sum of its 9m-point reflected extension, read from the window's own running sum
-(one pass, no extension is built), so a window costs O(m) and a level O(N m);
-Theo1 costs O(N m / 2) per level. A level's terms run in tasks of :data:`CHUNK`
-terms whose sums are added in task order; large levels run the tasks on every
-thread (numba's ``prange``) with the same result as the serial loop.
+Which path runs: an MTOTDEV or HTOTDEV level of gap-free data whose work
+n_terms (m + 10) exceeds :data:`FAST_WORK` (every octave level from N ~ 3000 on)
+is summed in O(N) by the blocked expansion of :mod:`avar._kernels.total_blocks`
+(exact up to rounding, ~1e-13 from the direct loop). Levels with gaps (each
+window touching one is skipped) and small levels (where the expansion's ~1 ms
+of tables per level costs more) take the direct loop here: each window is
+detrended and summed through the running sum of its 9m-point reflected
+extension, read from the window's own running sum (one pass, no extension is
+built), so a window costs O(m) and a level O(N m). Theo1 always takes the
+direct loop here, O(N m / 2) per level (:mod:`avar.stability.total` sends its
+long gap-free levels to :mod:`avar._kernels.theo_levels`). A level's terms run
+in tasks of :data:`CHUNK` terms whose sums are added in task order; large levels
+run the tasks on every thread (numba's ``prange``) with the same result as the
+serial loop.
 """
 
 from __future__ import annotations
