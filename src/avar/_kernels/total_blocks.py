@@ -140,20 +140,20 @@ def level_tables(m: int) -> tuple[np.ndarray, ...]:
 
 
 @njit(cache=True, nogil=True)
-def _trapezoids(same, m, count, weights):
-    """weights[lag, t] = the sum over the ``same`` rows (lag, lo, w) of w times the number of
-    (n, u), n < count, u < m, with n + lo + u = t: a double running sum of four spikes per row."""
-    weights[:, :] = 0.0
+def _trapezoids(same, m, count, weights, stop):
+    """weights[lag, t] (t < ``stop``) = the sum over the ``same`` rows (lag, lo, w) of w times the
+    number of (n, u), n < count, u < m, with n + lo + u = t: a double running sum of four spikes
+    per row."""
+    weights[:, :stop] = 0.0
     for r in range(same.shape[0]):
         lag, lo, w = same[r, 0], same[r, 1], float(same[r, 2])
-        weights[lag, lo] += w
-        weights[lag, lo + m] -= w
-        weights[lag, lo + count] -= w
-        weights[lag, lo + count + m] += w
+        for at, sign in ((lo, 1.0), (lo + m, -1.0), (lo + count, -1.0), (lo + count + m, 1.0)):
+            if at < stop:
+                weights[lag, at] += sign * w
     for lag in range(3):
         run = 0.0
         acc = 0.0
-        for t in range(weights.shape[1]):
+        for t in range(stop):
             run += weights[lag, t]
             acc += run
             weights[lag, t] = acc
@@ -185,10 +185,14 @@ def _prepare(values, n0, npts, x, parity):
 
 @njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
 def _same(x, weights, nx, m):
-    """1. sum_t x[t] (w0[t] x[t] + w1[t] x[t + m] + w2[t] x[t + 2m])."""
+    """1. sum_lag sum_t weights[lag, t] x[t] x[t + lag m] (the pairs lie in the block: t + lag m < nx)."""
     total = 0.0
-    for t in range(nx):
-        total += x[t] * (weights[0, t] * x[t] + weights[1, t] * x[t + m] + weights[2, t] * x[t + 2 * m])
+    for lag in range(3):
+        w = weights[lag]
+        acc = 0.0
+        for t in range(nx - lag * m):
+            acc += w[t] * x[t] * x[t + lag * m]
+        total += acc
     return total
 
 
@@ -214,28 +218,50 @@ def _opposite(x, parity, pairs, count, m):
 
 
 @njit(cache=True, nogil=True)
-def _windows(x, cross, points, square, count, m):
+def _moments(x, stop, m, moments):
+    """moments[p, n] = sum_{u<m} u^p x[n + u] for n < ``stop``, slid from n to n + 1 by exact
+    recurrences (the new term x[n + m] in, the old x[n] out)."""
+    f0 = 0.0
+    f1 = 0.0
+    f2 = 0.0
+    for u in range(m):
+        f0 += x[u]
+        f1 += u * x[u]
+        f2 += (u * u) * x[u]
+    last = m - 1.0
+    last2 = last * last
+    for n in range(stop):
+        moments[0, n] = f0
+        moments[1, n] = f1
+        moments[2, n] = f2
+        old = x[n]
+        new = x[n + m]
+        f2 = f2 - 2.0 * f1 + f0 + last2 * new - old
+        f1 = f1 - f0 + last * new + old
+        f0 = f0 + new - old
+
+
+@njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
+def _windows(x, moments, cross, points, square, count, m):
     """3. and 4.: sum_n 2 sum_j' U P + sum_j' P^2, from the scalars and the pieces' moments
-    f_{i,p}(n) = sum_{u<m} u^p x[n + i m + u], slid from n to n + 1 (exact recurrences)."""
+    f_{i,p}(n) = moments[p, n + i m]."""
     span = 3 * m
     half = span // 2
     gap = span - half
     tail = span * (span - 1) / 2.0
-    f = np.zeros((3, 3))
-    for i in range(3):
-        for u in range(m):
-            xu = x[i * m + u]
-            f[i, 0] += xu
-            f[i, 1] += u * xu
-            f[i, 2] += (u * u) * xu
-    f00, f01, f02 = f[0, 0], f[0, 1], f[0, 2]
-    f10, f11, f12 = f[1, 0], f[1, 1], f[1, 2]
-    f20, f21, f22 = f[2, 0], f[2, 1], f[2, 2]
     a00, a01, a02 = cross[0, 0, 0], cross[0, 1, 0], cross[0, 2, 0]
     a10, a11, a12 = cross[1, 0, 0], cross[1, 1, 0], cross[1, 2, 0]
-    c2 = cross[2]
-    last = m - 1.0
-    last2 = last * last
+    b00, b01, b02 = cross[2, 0, 0], cross[2, 0, 1], cross[2, 0, 2]
+    b10, b11, b12 = cross[2, 1, 0], cross[2, 1, 1], cross[2, 1, 2]
+    b20, b21, b22 = cross[2, 2, 0], cross[2, 2, 1], cross[2, 2, 2]
+    p00, p01, p02, p03 = points[0, 0], points[0, 1], points[0, 2], points[0, 3]
+    p10, p11, p12, p13 = points[1, 0], points[1, 1], points[1, 2], points[1, 3]
+    p20, p21, p22, p23 = points[2, 0], points[2, 1], points[2, 2], points[2, 3]
+    q00, q01, q02 = square[0, 0], 2.0 * square[0, 1], 2.0 * square[0, 2]
+    q11, q12, q22 = square[1, 1], 2.0 * square[1, 2], square[2, 2]
+    m0 = moments[0]
+    m1 = moments[1]
+    m2 = moments[2]
     total = 0.0
     for n in range(count):
         x0 = x[n]
@@ -244,26 +270,15 @@ def _windows(x, cross, points, square, count, m):
         x3 = x[n + span]
         s = ((x3 - x[n + gap]) - (x[n + half] - x0)) / half / gap
         mu = ((x3 - x0) - s * tail) / span
-        k0 = points[0, 0] * x0 + points[0, 1] * x1 + points[0, 2] * x2 + points[0, 3] * x3
-        k1 = points[1, 0] * x0 + points[1, 1] * x1 + points[1, 2] * x2 + points[1, 3] * x3
-        k2 = points[2, 0] * x0 + points[2, 1] * x1 + points[2, 2] * x2 + points[2, 3] * x3
-        k0 += a00 * f00 + a01 * f10 + a02 * f20
-        k1 += a10 * f00 + a11 * f10 + a12 * f20
-        k2 += (c2[0, 0] * f00 + c2[0, 1] * f01 + c2[0, 2] * f02 + c2[1, 0] * f10 + c2[1, 1] * f11
-               + c2[1, 2] * f12 + c2[2, 0] * f20 + c2[2, 1] * f21 + c2[2, 2] * f22)
-        total += 2.0 * (x0 * k0 + mu * k1 + s * k2)
-        total += (x0 * (square[0, 0] * x0 + 2.0 * (square[0, 1] * mu + square[0, 2] * s))
-                  + mu * (square[1, 1] * mu + 2.0 * square[1, 2] * s) + square[2, 2] * s * s)
-        # sum_{u<m} u^p x[o + 1 + u] from the sums at o (the new term x[o + m], the old x[o])
-        f02 = f02 - 2.0 * f01 + f00 + last2 * x1 - x0
-        f01 = f01 - f00 + last * x1 + x0
-        f00 = f00 + x1 - x0
-        f12 = f12 - 2.0 * f11 + f10 + last2 * x2 - x1
-        f11 = f11 - f10 + last * x2 + x1
-        f10 = f10 + x2 - x1
-        f22 = f22 - 2.0 * f21 + f20 + last2 * x3 - x2
-        f21 = f21 - f20 + last * x3 + x2
-        f20 = f20 + x3 - x2
+        f00, f10, f20 = m0[n], m0[n + m], m0[n + 2 * m]
+        k0 = p00 * x0 + p01 * x1 + p02 * x2 + p03 * x3 + a00 * f00 + a01 * f10 + a02 * f20
+        k1 = p10 * x0 + p11 * x1 + p12 * x2 + p13 * x3 + a10 * f00 + a11 * f10 + a12 * f20
+        k2 = (p20 * x0 + p21 * x1 + p22 * x2 + p23 * x3
+              + b00 * f00 + b01 * m1[n] + b02 * m2[n]
+              + b10 * f10 + b11 * m1[n + m] + b12 * m2[n + m]
+              + b20 * f20 + b21 * m1[n + 2 * m] + b22 * m2[n + 2 * m])
+        total += (2.0 * (x0 * k0 + mu * k1 + s * k2)
+                  + x0 * (q00 * x0 + q01 * mu + q02 * s) + mu * (q11 * mu + q12 * s) + q22 * s * s)
     return total
 
 
@@ -271,23 +286,24 @@ def _windows(x, cross, points, square, count, m):
 def _blocks(values, m, n_terms, size, first, stop, same, opposite, cross, points, square, out):
     """out[b] = the sum of Q(n) / (6 m^3) over the windows of block b, for b = first .. stop - 1."""
     span = 3 * m
-    length = size + span + 2 * m + 4
+    length = min(size, n_terms) + span + 2
     x = np.empty(length)
     weights = np.empty((3, length))
     parity = np.empty(length + 2)
+    moments = np.empty((3, length))
     scale = 6.0 * m * m * m
     made = -1
     for b in range(first, stop):
         n0 = b * size
         count = min(size, n_terms - n0)
-        if count != made:
-            _trapezoids(same, m, count, weights)
-            made = count
         nx = count + span
+        if count != made:
+            _trapezoids(same, m, count, weights, nx)
+            made = count
         _prepare(values, n0, nx - 1, x, parity)
-        x[nx : nx + 2 * m + 1] = 0.0
+        _moments(x, count + 2 * m, m, moments)
         out[b] = (_same(x, weights, nx, m) + _opposite(x, parity, opposite, count, m)
-                  + _windows(x, cross, points, square, count, m)) / scale
+                  + _windows(x, moments, cross, points, square, count, m)) / scale
 
 
 #: Windows per block, in units of m: each block reads (BLOCK + 3) m values. Larger blocks
