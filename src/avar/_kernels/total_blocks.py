@@ -57,7 +57,7 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
-from avar._kernels.tasks import run_ranges
+from avar._kernels.tasks import run_ranges, run_tasks, threads
 
 #: The weights of z_j = E(j + 3m) - 3 E(j + 2m) + 3 E(j + m) - E(j).
 _WEIGHTS = (-1, 3, -3, 1)
@@ -311,6 +311,11 @@ def _blocks(values, m, n_terms, size, first, stop, same, opposite, cross, points
 BLOCK = 3
 
 
+#: Blocks of at least this many windows (m >= 2^14) are not cut into more ranges than threads:
+#: fresh work arrays of ~50 MB cost more than the balance saves.
+LARGE_BLOCK = 1 << 16
+
+
 def block_size(m: int) -> int:
     """The windows of a block at factor m."""
     return BLOCK * m
@@ -327,5 +332,14 @@ def level_sum(values: np.ndarray, m: int) -> float:
     n_blocks = (n_terms + size - 1) // size
     out = np.zeros(n_blocks)
     tables = level_tables(m)
-    run_ranges(n_blocks, lambda first, stop: _blocks(values, m, n_terms, size, first, stop, *tables, out))
+
+    def work(first: int, stop: int) -> None:
+        _blocks(values, m, n_terms, size, first, stop, *tables, out)
+
+    if size < LARGE_BLOCK:
+        run_ranges(n_blocks, work)
+    else:  # one range per thread: each range allocates and first touches its block's arrays
+        parts = min(n_blocks, threads())
+        bounds = [n_blocks * p // parts for p in range(parts + 1)]
+        run_tasks(parts, lambda p: work(bounds[p], bounds[p + 1]))
     return float(np.sum(out))
