@@ -84,21 +84,49 @@ def test_tables_are_exact_integers():
 
 
 def test_levels_choose_their_path(monkeypatch):
-    """Gap-free levels with enough work take the expansion; levels with gaps the direct kernel."""
+    """Levels with enough (clean) windows take the expansion, small ones the direct kernel."""
     calls = []
-    monkeypatch.setattr(total, "level_sum", lambda values, m: calls.append(m) or 0.0)
+    monkeypatch.setattr(total, "level_sum", lambda values, m, clean=None: calls.append((m, clean is None)) or 0.0)
     x = SERIES[-1]
     assert (N - 2) * (1 + 10) > total.FAST_WORK  # m = 1 at N = 3000: just above the switch-over
     total.level_sums(0, x, np.array([1, 64]), NO_GAPS, 0)
     total.level_sums(1, x[:40], np.array([2]), NO_GAPS, 0)  # below it: too small to pay for the tables
-    assert calls == [1, 64]
+    assert calls == [(1, True), (64, True)]
     holed = x.copy()
     holed[100] = np.nan
     res = avar.mtotdev(holed, data_type="phase", taus=[64.0], nan_policy="omit")
-    assert calls == [1, 64] and res.n[0] < N - 3 * 64 + 1
-    calls.clear()
-    monkeypatch.undo()
-    a = avar.htotdev(x, data_type="phase", taus=[64.0], bias_correction=False)
-    monkeypatch.setattr(total, "FAST_WORK", 1 << 60)
-    b = avar.htotdev(x, data_type="phase", taus=[64.0], bias_correction=False)
-    assert a.deviation[0] == pytest.approx(b.deviation[0], rel=1e-11)
+    assert calls[2:] == [(64, False)] and res.n[0] == N - 3 * 64 + 1 - 101  # windows 0 .. 100 touch it
+
+
+def prefix_count(missing: np.ndarray) -> np.ndarray:
+    return np.concatenate(([0], np.cumsum(missing))).astype(np.int64)
+
+
+@pytest.mark.parametrize("shift", [0, 1])
+@pytest.mark.parametrize("kind", [0, 1])
+def test_gaps_run_the_blocks_over_the_clean_stretches(monkeypatch, kind, shift):
+    """Windows touching a gap are skipped: the expansion over each run of clean windows (the gaps
+    themselves NaN, so that reading one would show) equals the direct kernel's skipping loop."""
+    rng = np.random.default_rng(kind + 2 * shift)
+    x = SERIES[-2].copy()
+    missing = np.zeros(N - shift, dtype=bool)  # phase points (shift 0) or frequency samples (shift 1)
+    missing[[5, 6, 700, 1500, 1510]] = True
+    missing[rng.integers(2000, N - shift, 3)] = True
+    bad = prefix_count(missing)
+    x[np.flatnonzero(missing) + shift] = np.nan
+    factors = np.array([1, 2, 5, 16, 33, 150, 250])  # 3m = 750 fits between the gaps at 700 and 1500
+    fast = total.level_sums(kind, x, factors, bad, shift)
+    monkeypatch.setattr(total, "FAST_WORK", 1 << 62)
+    slow = total.level_sums(kind, x, factors, bad, shift)
+    assert fast[1].tolist() == slow[1].tolist() and slow[1][-1] > 0
+    np.testing.assert_allclose(fast[0], slow[0], rtol=1e-11)
+
+
+def test_block_lists_cover_the_clean_windows():
+    from avar._kernels.total_blocks import blocks
+
+    clean = np.array([1, 1, 1, 1, 1, 0, 0, 1, 0, 1, 1, 1, 1, 1, 1, 1], dtype=bool)
+    starts, counts = blocks(clean.size, 3, clean)
+    assert starts.tolist() == [0, 3, 7, 9, 12, 15] and counts.tolist() == [3, 2, 1, 3, 3, 1]
+    starts, counts = blocks(7, 3)
+    assert starts.tolist() == [0, 3, 6] and counts.tolist() == [3, 3, 1]

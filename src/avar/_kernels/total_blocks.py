@@ -38,6 +38,10 @@ and Q(n) = sum U^2 + 2 sum U P + sum P^2, summed over the windows of a block:
 Each part costs O(B + L) per block of B windows, so a level costs O(N) (~40 ns per
 window on one core, against ~30 m ns for the direct loop).
 
+Gaps: a run of windows n = a .. b - 1 that all avoid the gaps is every window of the
+gap-free slice ``values[a : b + L - 1]``, so the blocks are laid over those runs
+(:func:`blocks`) and never read a gap.
+
 Conditioning: the statistic is unchanged by adding a + b t to a window's values (the
 detrending removes it), so each block (its B windows, B + L - 1 values) first removes
 its own line and works in its own time t = 0 .. B + L - 1: the sums then stay on the
@@ -283,10 +287,11 @@ def _windows(x, moments, cross, points, square, count, m):
 
 
 @njit(cache=True, nogil=True)
-def _blocks(values, m, n_terms, size, first, stop, same, opposite, cross, points, square, out):
-    """out[b] = the sum of Q(n) / (6 m^3) over the windows of block b, for b = first .. stop - 1."""
+def _blocks(values, m, starts, counts, first, stop, same, opposite, cross, points, square, out):
+    """out[b] = the sum of Q(n) / (6 m^3) over the windows starts[b] .. starts[b] + counts[b] - 1,
+    for b = first .. stop - 1."""
     span = 3 * m
-    length = min(size, n_terms) + span + 2
+    length = counts[first:stop].max() + span + 2
     x = np.empty(length)
     weights = np.empty((3, length))
     parity = np.empty(length + 2)
@@ -294,13 +299,12 @@ def _blocks(values, m, n_terms, size, first, stop, same, opposite, cross, points
     scale = 6.0 * m * m * m
     made = -1
     for b in range(first, stop):
-        n0 = b * size
-        count = min(size, n_terms - n0)
+        count = counts[b]
         nx = count + span
         if count != made:
             _trapezoids(same, m, count, weights, nx)
             made = count
-        _prepare(values, n0, nx - 1, x, parity)
+        _prepare(values, starts[b], nx - 1, x, parity)
         _moments(x, count + 2 * m, m, moments)
         out[b] = (_same(x, weights, nx, m) + _opposite(x, parity, opposite, count, m)
                   + _windows(x, moments, cross, points, square, count, m)) / scale
@@ -321,20 +325,39 @@ def block_size(m: int) -> int:
     return BLOCK * m
 
 
-def level_sum(values: np.ndarray, m: int) -> float:
-    """sum over the windows n = 0 .. M - 3m of Q(n) / (6 m^3) on gap-free ``values`` (M points):
-    the direct kernel's level sum, in blocks of :func:`block_size` windows summed in order."""
+def blocks(n_terms: int, size: int, clean: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """First windows and window counts of the blocks: runs of at most ``size`` windows covering
+    the windows 0 .. n_terms - 1, or only those where ``clean`` (one flag per window) is set."""
+    if clean is None:
+        starts = np.arange(0, n_terms, size, dtype=np.int64)
+        return starts, np.minimum(size, n_terms - starts)
+    edges = np.diff(np.concatenate(([0], clean.astype(np.int8), [0])))
+    first, stop = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # runs of clean windows
+    per_run = (stop - first + size - 1) // size
+    run = np.repeat(np.arange(first.size), per_run)
+    index = np.arange(run.size) - np.repeat(np.cumsum(per_run) - per_run, per_run)
+    starts = (first[run] + index * size).astype(np.int64)
+    return starts, np.minimum(size, stop[run] - starts).astype(np.int64)
+
+
+def level_sum(values: np.ndarray, m: int, clean: np.ndarray | None = None) -> float:
+    """sum over the windows n = 0 .. M - 3m of Q(n) / (6 m^3) on ``values`` (M points), or over
+    the windows where ``clean`` is set (a window's values must then be real wherever it is set):
+    the direct kernel's level sum, in blocks of at most :func:`block_size` windows summed in order.
+    A run of clean windows n = a .. b - 1 is every window of ``values[a : b + 3m - 1]``."""
     m = int(m)
     n_terms = values.shape[0] - 3 * m + 1
     if n_terms <= 0:
         return 0.0
     size = block_size(m)
-    n_blocks = (n_terms + size - 1) // size
+    starts, counts = blocks(n_terms, size, clean)
+    n_blocks = starts.size
     out = np.zeros(n_blocks)
     tables = level_tables(m)
 
     def work(first: int, stop: int) -> None:
-        _blocks(values, m, n_terms, size, first, stop, *tables, out)
+        if stop > first:
+            _blocks(values, m, starts, counts, first, stop, *tables, out)
 
     if size < LARGE_BLOCK:
         run_ranges(n_blocks, work)

@@ -6,8 +6,8 @@ Defined as in NIST SP 1065 (Riley 2008) and Stable32, with the signature and
 for the shared conventions: frequency data become phase x = (0, cumsum(y))
 tau0, NaN gaps, confidence), plus ``alpha`` to fix the noise type and
 ``bias_correction``. The variances come from the kernels of
-:mod:`avar._kernels.total` (which sends the gap-free MTOTDEV and HTOTDEV levels
-to the O(N) expansion of :mod:`avar._kernels.total_blocks`); levels, EDF and
+:mod:`avar._kernels.total` (which sends the long MTOTDEV and HTOTDEV levels to
+the O(N) expansion of :mod:`avar._kernels.total_blocks`); levels, EDF and
 bias from :mod:`avar.stability.total_edf`.
 """
 
@@ -192,9 +192,9 @@ def mtotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     below m = 10, as Stable32, then b N / m - c (NIST SP 1065 Table 8).
     ``bias_correction=True`` divides by MTOTVAR / MVAR (0.94, 0.83, 0.73, 0.70,
     0.69 for alpha = 2 .. -2); Stable32 and ``allantools`` do not (default False).
-    Each level costs O(N) (gap-free data: the blocked expansion of
-    :mod:`avar._kernels.total_blocks`, exact up to rounding) or O(N m) (with gaps,
-    and small levels: the direct loop).
+    Each level costs O(N) (the blocked expansion of :mod:`avar._kernels.total_blocks`
+    over the runs of windows that avoid the gaps, exact up to rounding; small
+    levels take the direct O(N m) loop, cheaper there).
     {parameters}
     References
     ----------
@@ -250,8 +250,8 @@ def htotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     = 1 + a for m > 1, a = -0.005, -0.149, -0.229 for alpha = 0, -1, -2 (none
     for PM noise); ``allantools`` applies none. EDF: the Hadamard variance's
     below m = 16, then (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`),
-    which equals Stable32's printed bounds from m = 16. Each level costs O(N)
-    or, with gaps, O(N m), as :func:`mtotdev`.
+    which equals Stable32's printed bounds from m = 16. Each level costs O(N),
+    as :func:`mtotdev`.
     {parameters}
     References
     ----------
