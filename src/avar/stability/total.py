@@ -106,8 +106,11 @@ def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.nd
     if estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
         sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift)[0])[0]
         counts = x.shape[0] - factors
-    else:
-        sums, counts = level_sums(_KIND[estimator], x, factors, bad, shift)
+    else:  # HTOTDEV's m = 1 is OHDEV (below): its level is not summed
+        first = int(estimator == "htotdev" and factors.size > 0 and factors[0] == 1)
+        sums, counts = level_sums(_KIND[estimator], x, factors[first:], bad, shift)
+        sums = np.concatenate((np.zeros(first), sums))
+        counts = np.concatenate((np.zeros(first, dtype=counts.dtype), counts))
     m = factors.astype(np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         if estimator == "htotdev":
