@@ -35,7 +35,7 @@ and Q(n) = sum U^2 + 2 sum U P + sum P^2, summed over the windows of a block:
    times integer tables;
 4. sum_j' P^2: a 3 x 3 table times (X(n), mu_n, s_n).
 
-Each part costs O(B + L) per block of B windows, so a level costs O(N) (~40 ns per
+Each part costs O(B + L) per block of B windows, so a level costs O(N) (30-50 ns per
 window on one core, against ~30 m ns for the direct loop).
 
 Gaps: a run of windows n = a .. b - 1 that all avoid the gaps is every window of the
@@ -46,8 +46,8 @@ Conditioning: the statistic is unchanged by adding a + b t to a window's values 
 detrending removes it), so each block (its B windows, B + L - 1 values) first removes
 its own line and works in its own time t = 0 .. B + L - 1: the sums then stay on the
 scale of the block's wander, not of the record's (a single expansion over the record
-loses ~(N / m)^3 to cancellation on random-walk FM). With B = 3m the result agrees with
-the direct loop to ~1e-13 on white PM, flicker PM, flicker FM and random-walk FM phase
+loses ~(N / m)^3 to cancellation on random-walk FM). With B = 3m (at least 12) the result agrees
+with the direct loop to ~1e-13 on white PM, flicker PM, flicker FM and random-walk FM phase
 and frequency; the loss grows about as (B / m)^3 (1e-10 at B = 12 m), hence
 :data:`BLOCK`. The tables (exact integers, built in Python per level) come from
 :func:`level_tables`; the tests check the expansion against the direct kernel and the
