@@ -45,11 +45,11 @@ gap-free slice ``values[a : b + L - 1]``, so the blocks are laid over those runs
 Conditioning: the statistic is unchanged by adding a + b t to a window's values (the
 detrending removes it), so each block (its B windows, B + L - 1 values) first removes
 its own line and works in its own time t = 0 .. B + L - 1: the sums then stay on the
-scale of the block's wander, not of the record's (a single expansion over the record
-loses ~(N / m)^3 to cancellation on random-walk FM). With B = 3m (at least 12) the result agrees
-with the direct loop to ~1e-13 on white PM, flicker PM, flicker FM and random-walk FM phase
-and frequency; the loss grows about as (B / m)^3 (1e-10 at B = 12 m), hence
-:data:`BLOCK`. The tables (exact integers, built in Python per level) come from
+scale of the block's wander, not of the record's. With B = 3m (at least 12) the result
+agrees with the direct loop to ~1e-13 on white PM, flicker PM, flicker FM and random-walk
+FM phase and frequency (measured up to N = 1e6); the loss grows about as (B / m)^3 on
+random-walk FM (1e-10 at B = 12 m, 1e-6 at B = 256 and m = 1), so one expansion over the
+whole record would be useless there; hence :data:`BLOCK`. The tables (exact integers, built in Python per level) come from
 :func:`level_tables`; the tests check the expansion against the direct kernel and the
 exact formula.
 """
