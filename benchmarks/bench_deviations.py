@@ -11,10 +11,12 @@ Usage::
 correction so that both compute the same numbers) against allantools, timed
 once per call (allantools is O(N^2) Python: 10 s for MTOTDEV at N = 3e3) up
 to ``--peer-max`` points, and ours alone beyond (ThêoH has no peer); wall and
-CPU time (the CPU time counts every thread). MTOTDEV, TTOTDEV and HTOTDEV cost
-O(N m) per level: above ``--loop-max`` points they are not run, and their time
-is extrapolated from the largest N timed by the octave sum of (N - 3m + 1) m
-(marked ``~``; the default sizes 3e3 1e5 1e6 print Theo1 and ThêoH at 1e6).
+CPU time (the CPU time counts every thread). MTOTDEV, TTOTDEV and HTOTDEV are
+also timed in the same run by the direct O(N m) loop they used before the
+blocked O(N) expansion (:mod:`avar._kernels.total_blocks`), with the largest
+relative difference of the two results; above ``--loop-max`` points the loop is
+not run and its time is extrapolated from the largest N timed by the octave sum
+of (N - 3m + 1) m (marked ``~``).
 
 Frequency data (white FM), ``taus="octave"`` on both sides (allantools is given
 our averaging times, so both compute the same levels). Columns:
@@ -116,42 +118,67 @@ def window_points(n: int) -> float:
     return float(np.sum((n - 3 * m + 1) * m))
 
 
-#: The statistics whose levels cost O(N m).
+#: The statistics whose levels cost O(N m) by the direct loop (O(N) by the blocked expansion).
 LOOPS = ("mtotdev", "ttotdev", "htotdev")
 
 
+@contextlib.contextmanager
+def direct_loop():
+    """MTOTDEV, TTOTDEV and HTOTDEV by the direct O(N m) loop (the path before the expansion)."""
+    from avar._kernels import total
+
+    saved = total.FAST_WORK
+    total.FAST_WORK = 1 << 62
+    try:
+        yield
+    finally:
+        total.FAST_WORK = saved
+
+
+def timed(function, y, options) -> tuple[float, float, object]:
+    """Wall and CPU time (s) of one call, and its result."""
+    results = []
+    cpu = time.process_time()
+    wall = once(lambda: results.append(function(y, **options)))
+    return wall, time.process_time() - cpu, results[0]
+
+
 def bench_total(sizes: list[int], peer_max: int, loop_max: int) -> None:
-    """Time the total and Theo statistics against allantools (up to ``peer_max`` points)."""
-    print("| statistic | N | levels | allantools (ms) | avar wall (ms) | avar CPU (ms) | avar vs allantools |")
-    print("|---|---|---|---|---|---|---|")
-    measured = {}  # statistic -> (N, wall, cpu) of its largest run
+    """Time the total and Theo statistics against allantools (up to ``peer_max`` points); MTOTDEV,
+    TTOTDEV and HTOTDEV also by the direct loop (up to ``loop_max`` points, extrapolated beyond)."""
+    print("| statistic | N | levels | allantools (ms) | avar wall (ms) | avar CPU (ms) | avar vs allantools "
+          "| direct loop wall (ms) | direct loop CPU (ms) | direct / avar (wall) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    measured = {}  # statistic -> (N, wall, cpu) of the direct loop's largest run
     for n in sizes:
         y = np.random.default_rng(0).standard_normal(n) * 1e-11
         for name in TOTAL:
-            if name in LOOPS and n > loop_max:
-                if name in measured:
-                    base, wall, cpu = measured[name]
-                    scale = window_points(n) / window_points(base)
-                    print(f"| {name} | {n:.0e} | - | - | ~{wall * scale * 1e3:.3g} | ~{cpu * scale * 1e3:.3g} "
-                          f"| (extrapolated from N = {base:.0e}) |", flush=True)
-                continue
             options = {} if name == "theoh" else {"bias_correction": False}
             function = getattr(avar, name)
             function(y[:1000], **options)  # numba compilation
-            results = []
-            cpu = time.process_time()
-            ours = once(lambda: results.append(function(y, **options)))  # noqa: B023
-            cpu = time.process_time() - cpu
-            measured[name] = (n, ours, cpu)
-            levels = len(results[0])
+            ours, cpu, result = timed(function, y, options)
             peer = "-"
             ratio = "-"
             if allantools is not None and name != "theoh" and n <= peer_max:
-                factors = results[0].averaging_factors.astype(float)
+                factors = result.averaging_factors.astype(float)
                 at = getattr(allantools, name)
                 seconds = once(lambda: at(y, rate=1.0, data_type="freq", taus=factors))  # noqa: B023
                 peer, ratio = f"{seconds * 1e3:.0f}", f"{seconds / ours:.0f}x"
-            print(f"| {name} | {n:.0e} | {levels} | {peer} | {ours * 1e3:.1f} | {cpu * 1e3:.1f} | {ratio} |",
+            loop = "| - | - | - |"
+            if name in LOOPS:
+                if n <= loop_max:
+                    with direct_loop():
+                        function(y[:1000], **options)
+                        wall, loop_cpu, direct = timed(function, y, options)
+                    measured[name] = (n, wall, loop_cpu)
+                    worst = np.max(np.abs(direct.variance / result.variance - 1))
+                    loop = f"| {wall * 1e3:.1f} | {loop_cpu * 1e3:.1f} | {wall / ours:.0f}x (rel. diff {worst:.0e}) |"
+                elif name in measured:
+                    base, wall, loop_cpu = measured[name]
+                    scale = window_points(n) / window_points(base)
+                    loop = (f"| ~{wall * scale * 1e3:.3g} | ~{loop_cpu * scale * 1e3:.3g} | ~{wall * scale / ours:.0f}x "
+                            f"(extrapolated from N = {base:.0e}) |")
+            print(f"| {name} | {n:.0e} | {len(result)} | {peer} | {ours * 1e3:.1f} | {cpu * 1e3:.1f} | {ratio} {loop}",
                   flush=True)
 
 
@@ -163,7 +190,7 @@ def main() -> None:
                         help="N of --total (default 3e3 1e5 1e6)")
     parser.add_argument("--peer-max", type=int, default=3000, help="largest N timed for allantools in --total")
     parser.add_argument("--loop-max", type=int, default=100000,
-                        help="largest N run for the O(N m) statistics in --total (beyond: extrapolated)")
+                        help="largest N run by the direct O(N m) loop in --total (beyond: extrapolated)")
     args = parser.parse_args()
     warnings.simplefilter("ignore")  # allantools' polyfit RankWarning on long series
     if args.total:

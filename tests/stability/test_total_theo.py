@@ -114,6 +114,7 @@ def test_threads_give_the_serial_sums(monkeypatch):
     from avar._kernels import total
 
     x = np.cumsum(RNG.standard_normal(3000))
+    monkeypatch.setattr(total, "FAST_WORK", 1 << 62)  # the direct loop (tests/stability/test_total_blocks.py: the rest)
     for kind, m in ((0, 5), (1, 3), (2, 40)):  # several tasks of CHUNK terms each
         monkeypatch.setattr(total, "PARALLEL_WORK", 1 << 60)
         serial = total.level_sums(kind, x, np.array([m]), NO_GAPS, 0)

@@ -11,18 +11,28 @@ the input + 1; empty when there is none) and ``shift`` is 0 for phase data
 ``x[k + 1] - x[k]`` is missing). A term whose phase points ``start .. stop - 1``
 touch a gap is skipped; the kernels return the sum and the number of terms used.
 
-Each window of the total statistics is detrended and summed through the running
-sum of its 9m-point reflected extension, read from the window's own running sum
-(one pass, no extension is built), so a window costs O(m) and a level O(N m);
-Theo1 costs O(N m / 2) per level. A level's terms run in tasks of :data:`CHUNK`
-terms whose sums are added in task order; large levels run the tasks on every
-thread (numba's ``prange``) with the same result as the serial loop.
+Which path runs: an MTOTDEV or HTOTDEV level whose work, (windows avoiding the
+gaps) x (m + 10), exceeds :data:`FAST_WORK` (every octave level from N ~ 3000 on)
+is summed in O(N) by the blocked expansion of :mod:`avar._kernels.total_blocks`
+(exact up to rounding, ~1e-13 from the direct loop), over each run of windows
+that avoid the gaps. Smaller levels (where the expansion's ~1 ms of tables per
+level costs more) take the direct loop here: each window is detrended and
+summed through the running sum of its 9m-point reflected extension, read from
+the window's own running sum (one pass, no extension is built), so a window
+costs O(m) and a level O(N m). Theo1 always takes the direct loop here,
+O(N m / 2) per level (:mod:`avar.stability.total` sends its long gap-free levels
+to :mod:`avar._kernels.theo_levels`). A level's terms run in tasks of
+:data:`CHUNK` terms whose sums are added in task order; large levels run the
+tasks on every thread (numba's ``prange``) with the same result as the serial
+loop.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
+
+from avar._kernels.total_blocks import level_sum
 
 
 @njit(cache=True)
@@ -172,9 +182,24 @@ def _level_parallel(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shif
 PARALLEL_WORK = 1 << 24
 
 
+#: MTOTDEV and HTOTDEV levels with (windows avoiding the gaps) x (m + 10) above this take the
+#: blocked O(N) expansion of :mod:`avar._kernels.total_blocks`; smaller ones the direct loop,
+#: which is cheaper there (the expansion costs ~1 ms of tables per level).
+FAST_WORK = 1 << 15
+
+
 def _level(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, n_terms: int) -> tuple[float, int]:
     """One level's sum over its ``n_terms`` terms, in tasks of :data:`CHUNK` summed in order
     (serially for small levels: threads cost more than they save there)."""
+    if kind < 2 and n_terms > 0:
+        clean = None
+        used = n_terms
+        if bad.shape[0]:  # the windows n whose points n .. n + 3m - 1 + kind avoid every gap
+            stop = 3 * m + kind - shift
+            clean = bad[stop : stop + n_terms] == bad[:n_terms]
+            used = int(np.count_nonzero(clean))
+        if used * (m + 10) > FAST_WORK:
+            return level_sum(values, m, clean), used
     work = n_terms * m * (1 if kind == 2 else 3)
     if work > PARALLEL_WORK and n_terms > CHUNK:
         return _level_parallel(kind, values, m, bad, shift, n_terms)

@@ -6,7 +6,9 @@ Defined as in NIST SP 1065 (Riley 2008) and Stable32, with the signature and
 for the shared conventions: frequency data become phase x = (0, cumsum(y))
 tau0, NaN gaps, confidence), plus ``alpha`` to fix the noise type and
 ``bias_correction``. The variances come from the kernels of
-:mod:`avar._kernels.total`; levels, EDF and bias from :mod:`avar.stability.total_edf`.
+:mod:`avar._kernels.total` (which sends the long MTOTDEV and HTOTDEV levels to
+the O(N) expansion of :mod:`avar._kernels.total_blocks`); levels, EDF and
+bias from :mod:`avar.stability.total_edf`.
 """
 
 from __future__ import annotations
@@ -104,8 +106,11 @@ def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.nd
     if estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
         sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift)[0])[0]
         counts = x.shape[0] - factors
-    else:
-        sums, counts = level_sums(_KIND[estimator], x, factors, bad, shift)
+    else:  # HTOTDEV's m = 1 is OHDEV (below): its level is not summed
+        first = int(estimator == "htotdev" and factors.size > 0 and factors[0] == 1)
+        sums, counts = level_sums(_KIND[estimator], x, factors[first:], bad, shift)
+        sums = np.concatenate((np.zeros(first), sums))
+        counts = np.concatenate((np.zeros(first, dtype=counts.dtype), counts))
     m = factors.astype(np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         if estimator == "htotdev":
@@ -190,7 +195,9 @@ def mtotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     below m = 10, as Stable32, then b N / m - c (NIST SP 1065 Table 8).
     ``bias_correction=True`` divides by MTOTVAR / MVAR (0.94, 0.83, 0.73, 0.70,
     0.69 for alpha = 2 .. -2); Stable32 and ``allantools`` do not (default False).
-    Each level costs O(N m).
+    Each level costs O(N) (the blocked expansion of :mod:`avar._kernels.total_blocks`
+    over the runs of windows that avoid the gaps, exact up to rounding; small
+    levels take the direct O(N m) loop, cheaper there).
     {parameters}
     References
     ----------
@@ -246,7 +253,8 @@ def htotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     = 1 + a for m > 1, a = -0.005, -0.149, -0.229 for alpha = 0, -1, -2 (none
     for PM noise); ``allantools`` applies none. EDF: the Hadamard variance's
     below m = 16, then (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`),
-    which equals Stable32's printed bounds from m = 16.
+    which equals Stable32's printed bounds from m = 16. Each level costs O(N),
+    as :func:`mtotdev`.
     {parameters}
     References
     ----------
