@@ -340,3 +340,31 @@ def test_theo1_by_fft_equals_the_direct_sum(monkeypatch):
         monkeypatch.setattr(theo_levels, "DIRECT_TERMS", 0)
         np.testing.assert_allclose(avar.theo1(phase, data_type="phase", taus="all").deviation, slow.deviation,
                                    rtol=1e-10)
+
+
+def test_theobr_factor_of_random_walk_fm_redoes_only_the_levels_kf_needs(monkeypatch):
+    """Random-walk FM: most expansions of kf's Theo1 sums are ill-conditioned at the per-level
+    tolerance, but kf is their mean: summing directly only the worst (the smallest m) keeps
+    kf within its tolerance of the all-direct mean, with far fewer direct sums."""
+    import avar.stability.theo as theo
+
+    y = np.cumsum(np.random.default_rng(11).standard_normal(6000))
+    x = np.concatenate([[0.0], np.cumsum(y)])
+    x -= np.polyval(np.polyfit(np.arange(x.size), x, 1), np.arange(x.size))  # as prepared_phase
+    calls = []
+
+    def counted(x, m, bad, shift):
+        calls.append(m)
+        return theo1_sum(x, m, bad, shift)
+
+    monkeypatch.setattr(theo, "theo1_sum", counted)
+    kf_default, n = theo.theobr_factor(x)
+    monkeypatch.setattr(theo, "KF_TOLERANCE", 1e-12)  # at N = 6000 the default needs no direct sum
+    calls.clear()
+    kf, n = theo.theobr_factor(x)
+    direct = np.mean([oavar_sums(x, np.array([9 + 3 * i]))[0] / (2 * (9 + 3 * i) ** 2 * (x.size - 2 * (9 + 3 * i)))
+                      / (theo1_sum(x, 12 + 4 * i, NO_GAPS, 0)[0] / (0.75 * (x.size - 12 - 4 * i) * (12 + 4 * i) ** 2))
+                      for i in range(n + 1)])
+    assert kf_default == pytest.approx(direct, rel=1e-8)
+    assert kf == pytest.approx(direct, rel=1e-11)
+    assert 0 < len(calls) < n + 1 and 12 + 4 * n not in calls  # the worst conditioned: small factors

@@ -26,6 +26,12 @@ from avar.stability.total_edf import total_edf, total_factors
 
 #: Fewest phase points: TheoBR's average needs n = floor(N / 30) - 3 >= 0.
 MIN_THEOH_POINTS = 90
+#: Relative error of an expanded Theo1 sum per unit of its conditioning ratio (measured:
+#: at most 6.7e-15 over the levels of random-walk FM, N = 2e4, against the direct sums).
+ERROR_PER_RATIO = 1e-14
+#: Relative error allowed in TheoBR's kf from the expanded Theo1 sums of its average (kf is
+#: an estimate whose own statistical uncertainty is of order 1e-2; ThêoH prints 5 digits).
+KF_TOLERANCE = 1e-8
 
 
 def theobr_factor(x: np.ndarray) -> tuple[float, int]:
@@ -47,12 +53,33 @@ def theobr_factor(x: np.ndarray) -> tuple[float, int]:
     avar_sums[redo] = oavar_sums(x, m_avar[redo])
     every, ratio = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
     theo_sums = every[m_theo]
-    no_gaps = np.zeros(0, dtype=np.int64)
-    for level in np.flatnonzero(ratio[m_theo] > MAX_RATIO):
-        theo_sums[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0]
     avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
+    no_gaps = np.zeros(0, dtype=np.int64)
+    for level in _levels_to_redo(avar / (theo_sums / (0.75 * (n_points - m_theo) * m_theo * m_theo)),
+                                 ratio[m_theo]):
+        theo_sums[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0]
     theo = theo_sums / (0.75 * (n_points - m_theo) * m_theo * m_theo)
     return float(np.mean(avar / theo)), n
+
+
+def _levels_to_redo(terms: np.ndarray, ratio: np.ndarray) -> np.ndarray:
+    """The Theo1 levels of kf's average to sum directly: the worst-conditioned first, until
+    the error the others can bring to the mean of ``terms`` is below :data:`KF_TOLERANCE`.
+
+    A level's expanded sum errs by about ERROR_PER_RATIO x its ratio (relative), which
+    reaches its term of the mean; kf averages thousands of levels, so it needs far fewer
+    direct sums than a per-level tolerance would (random-walk FM, N = 1e5: about 50 of 3332
+    levels, the smallest m, instead of 1368). A non-finite term or ratio is always redone.
+    """
+    error = np.abs(terms) * ERROR_PER_RATIO * ratio
+    error[~np.isfinite(error)] = np.inf
+    order = np.argsort(-error, kind="stable")
+    remaining = np.cumsum(error[order][::-1])[::-1]  # error of the levels from this one on
+    finite = np.abs(terms[np.isfinite(terms)])
+    # the mean's scale from the median term, which a few ill-conditioned terms cannot inflate
+    budget = KF_TOLERANCE * terms.size * (float(np.median(finite)) if finite.size else 0.0)
+    count = int(np.count_nonzero(~(remaining <= budget)))
+    return np.sort(order[:count])
 
 
 def _levels(n_phase: int, rate: float, taus: Any, k: float) -> tuple[np.ndarray, np.ndarray]:
@@ -85,7 +112,7 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
 
     N phase points. kf removes Theo1's bias against the Allan variance for any
     noise mix without identifying it (TheoBR, Howe and Tasset 2004; Taylor
-    and Howe 2010 compute it decimated; this one is exact). The levels come
+    and Howe 2010 compute it decimated; this one is exact to 1e-8). The levels come
     from the tau grid of each part: OADEV's factors m (``taus`` as
     :func:`avar.oadev`) below k, Theo1's even m (``taus`` as
     :func:`avar.theo1`, tau = 0.75 m tau0) from k. Each level's noise is
@@ -93,7 +120,10 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. kf needs Theo1 at every m = 2 .. N / 7.5
     and OAVAR at N / 30 factors, all at once from FFT autocorrelations in O(N log N)
     (:func:`avar._kernels.theo.theo1_every`); a sum whose expansion is ill-conditioned
-    (random-walk FM: most of them) is summed directly, exactly but in O(N m). ``n``: N - 2m
+    is summed directly, exactly but in O(N m): every
+    displayed Theo1 level whose expansion may err by more than about 1e-10, and of kf's
+    average the worst-conditioned levels until kf itself is good to 1e-8 (random-walk FM:
+    the smallest m; at N = 1e5 about 50 of 3,300 levels). ``n``: N - 2m
     (OADEV), (N - m) m / 2 (Theo1, as Stable32). Dimensionless.
 
     Parameters
