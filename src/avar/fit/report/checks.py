@@ -99,9 +99,10 @@ def data_warnings(channel: str, kind: str | None, values: np.ndarray, freq: floa
         distinct = np.unique(x[: min(n, 100_000)]).size
         if repeated > 0.5 and distinct > 8:
             out.append(f"{channel}: {100 * repeated:.3g} % of consecutive samples repeat (stuck or held output)")
-        spread = 1.4826 * float(np.median(np.abs(steps - np.median(steps))))
+        departure = np.abs(steps - np.median(steps))
+        spread = 1.4826 * float(np.median(departure))
         if spread > 0:
-            outliers = int(np.count_nonzero(np.abs(steps - np.median(steps)) > OUTLIER_MAD * spread))
+            outliers = int(np.count_nonzero(departure > OUTLIER_MAD * spread))
             if outliers > max(10, OUTLIER_SHARE * n):
                 remedy = "the robust Allan variance sets them aside" if robust else \
                     "pass --robust (robust=True) to fit the clean process"

@@ -18,8 +18,11 @@ D(k) = Var(y_{t+k} - y_t) of the whole model (the sum of its terms')::
     Cov(y_a - y_b, y_c - y_d) = [D(a - d) + D(b - c) - D(a - c) - D(b - d)] / 2,
     sum_{i<L1} sum_{l<L2} D(c + i - l) = S2(c + L1 + 1) - S2(c + L1 - L2 + 1) - S2(c + 1) + S2(c - L2 + 1),
 
-S2 the second cumulative sum of D (summed outward from 0), so
-gamma_jk(h) costs 16 table reads at any m. The sum over h runs exactly near
+S2 the second cumulative sum of D, so gamma_jk(h) costs 16 reads of S2 at any m.
+gamma is linear in D: the model's is the sum of its terms' scales times the
+unit terms' gamma, which depend only on the log's length and grid and are
+computed once for every channel. S2 of QN, WN, FN and RW is in closed form
+(no table of the log's length); a Gauss-Markov term's is summed outward from 0. The sum over h runs exactly near
 the kinks of gamma_jk and c_jk and by the trapezoid rule on integer nodes in
 between (the summand is smooth there), a few thousand evaluations per pair of
 levels whatever N.
@@ -111,8 +114,10 @@ def _second_sums(structure: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(s1)])
 
 
-def _s2(table: np.ndarray, x: np.ndarray) -> np.ndarray:
-    return table[np.where(x < 0, 2 - x, x)]
+def _s2(source: np.ndarray | str, x: np.ndarray) -> np.ndarray:
+    """S2 at integers x (D is even: S2(-x) = S2(x + 2)), from a table or a unit term's closed form."""
+    folded = np.where(x < 0, 2 - x, x)
+    return _unit_second_sums(source, folded) if isinstance(source, str) else source[folded]
 
 
 def _nodes(low: int, high: int, kinks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -164,13 +169,17 @@ def level_covariance(components: Sequence[Component], n: int, factors: np.ndarra
     memory = any(c.kind in ("FN", "AR1") for c in components)
     # a Gauss-Markov term's covariance (phi^h) squared falls below 1e-6 of its start after this many lags
     memory_lags = max([math.ceil(7.0 / -math.log(c.shape)) for c in components if c.kind == "AR1"], default=0)
-    plan = _lag_plan(int(n), tuple(int(m) for m in factors), memory, memory_lags)
-    s2 = _combined_second_sums(components, plan.size)
+    key = (int(n), tuple(int(m) for m in factors), memory, memory_lags)
+    plan = _lag_plan(*key)
+    gamma = np.zeros(plan.h.size)
+    for c in components:
+        if c.kind in UNIT_KINDS:
+            gamma += c.scale * _unit_gamma(key, c.kind)
+    shaped = [c for c in components if c.kind == "AR1"]
+    if shaped:
+        gamma += _gamma(_second_sums(structure_function(shaped, plan.size)), plan)
     ramp = sum(c.scale for c in components if c.kind == "DR")
     mean2 = (ramp / 2.0) * plan.mj * plan.mk  # mu_j mu_k at every node, mu_m = sqrt(omega2 / 2) m
-    gamma = (_phi(s2, plan.mj - plan.h, plan.mj, plan.mk) + _phi(s2, -plan.h - plan.mk, plan.mj, plan.mk)
-             - _phi(s2, plan.mj - plan.mk - plan.h, plan.mj, plan.mk) - _phi(s2, -plan.h, plan.mj, plan.mk))
-    gamma /= 4.0 * plan.mj * plan.mk
     totals = np.add.reduceat(plan.weights * (2.0 * gamma * gamma + 4.0 * mean2 * gamma), plan.starts)
     out = np.empty((factors.size, factors.size))
     out[plan.j, plan.k] = out[plan.k, plan.j] = totals / plan.norms
@@ -222,23 +231,45 @@ def _lag_plan(n: int, factors: tuple[int, ...], memory: bool, memory_lags: int) 
                  norms=np.array([p[4] for p in pieces]), size=reach + 4 * top + 4)
 
 
-def _combined_second_sums(components: Sequence[Component], size: int) -> np.ndarray:
-    """S2 of the model: the scales times the cached unit tables, plus any Gauss-Markov term's own."""
-    out = np.zeros(size + 3)  # S2(0..size + 2)
-    for c in components:
-        if c.kind in UNIT_KINDS:
-            out += c.scale * _unit_second_sums(c.kind, size)
-    shaped = [c for c in components if c.kind == "AR1"]
-    if shaped:
-        out += _second_sums(structure_function(shaped, size))
-    return out
-
-
-@functools.lru_cache(maxsize=len(UNIT_KINDS))  # one log's length: the channels of a report share them
-def _unit_second_sums(kind: str, size: int) -> np.ndarray:
-    out = _second_sums(_unit_structure(kind, size))
+@functools.lru_cache(maxsize=2 * len(UNIT_KINDS))  # one log's length and grid: shared by its channels
+def _unit_gamma(key: tuple, kind: str) -> np.ndarray:
+    """gamma_jk(h) at every node of the plan ``key`` for a unit term of ``kind``."""
+    out = _gamma(kind, _lag_plan(*key))
     out.flags.writeable = False
     return out
+
+
+def _gamma(s2: np.ndarray | str, plan: _Plan) -> np.ndarray:
+    """gamma_jk(h) at the plan's nodes from S2 (a table, or the name of a unit term)."""
+    mj, mk, h = plan.mj, plan.mk, plan.h
+    total = (_phi(s2, mj - h, mj, mk) + _phi(s2, -h - mk, mj, mk) - _phi(s2, mj - mk - h, mj, mk)
+             - _phi(s2, -h, mj, mk))
+    return total / (4.0 * mj * mk)
+
+
+def _unit_second_sums(kind: str, x: np.ndarray) -> np.ndarray:
+    """S2(x), x >= 0 integers, of a unit term, in closed form (S2(x) = sum_{u<x-1} (x - 1 - u) D(u)).
+
+    QN: 2 x (x - 2) (x >= 2); WN: (x - 1)(x - 2) (x >= 1); RW: x (x - 1)(x - 2) / 6;
+    FN: [A (A - 2) O(x - 2) - 2 (A - 1)(x - 2) + (x - 2)^2] / (2 pi) (x >= 2), A = 2x - 1,
+    O(k) = sum_{j<=k} 1 / (2j - 1) = (psi(k + 1/2) - psi(1/2)) / 2.
+
+    >>> (_unit_second_sums("FN", np.array([3, 4])) * math.pi / 4).round(6).tolist()  # D(1) = 1, D(2) = 4 / 3
+    [1.0, 3.333333]
+    """
+    x = np.asarray(x, dtype=np.float64)
+    if kind == "QN":
+        return np.where(x >= 2.0, 2.0 * x * (x - 2.0), 0.0)
+    if kind == "WN":
+        return np.where(x >= 1.0, (x - 1.0) * (x - 2.0), 0.0)
+    if kind == "RW":
+        return x * (x - 1.0) * (x - 2.0) / 6.0
+    from scipy.special import digamma
+
+    k = np.maximum(x - 2.0, 0.0)
+    a = 2.0 * x - 1.0
+    odd = 0.5 * (digamma(k + 0.5) - digamma(0.5))
+    return np.where(x >= 2.0, (a * (a - 2.0) * odd - 2.0 * (a - 1.0) * k + k * k) / (2.0 * math.pi), 0.0)
 
 
 def _interpolated(components: Sequence[Component], n: int, factors: np.ndarray) -> np.ndarray:
@@ -270,6 +301,6 @@ def _interpolated(components: Sequence[Component], n: int, factors: np.ndarray) 
     return out * np.outer(nu, nu)
 
 
-def _phi(s2: np.ndarray, c: np.ndarray, l1: np.ndarray | int, l2: np.ndarray | int) -> np.ndarray:
+def _phi(s2: np.ndarray | str, c: np.ndarray, l1: np.ndarray | int, l2: np.ndarray | int) -> np.ndarray:
     """sum_{i<l1} sum_{l<l2} D(c + i - l) for integer arrays c (l1, l2 arrays of the same shape, or ints)."""
     return _s2(s2, c + l1 + 1) - _s2(s2, c + l1 - l2 + 1) - _s2(s2, c + 1) + _s2(s2, c - l2 + 1)
