@@ -52,13 +52,12 @@ def theobr_factor(x: np.ndarray) -> tuple[float, int]:
     redo = avar_ratio > MAX_RATIO
     avar_sums[redo] = oavar_sums(x, m_avar[redo])
     every, ratio = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
-    theo_sums = every[m_theo]
+    theo_norm = 0.75 * (n_points - m_theo) * m_theo * m_theo
+    theo = every[m_theo] / theo_norm
     avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
     no_gaps = np.zeros(0, dtype=np.int64)
-    for level in _levels_to_redo(avar / (theo_sums / (0.75 * (n_points - m_theo) * m_theo * m_theo)),
-                                 ratio[m_theo]):
-        theo_sums[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0]
-    theo = theo_sums / (0.75 * (n_points - m_theo) * m_theo * m_theo)
+    for level in _levels_to_redo(avar / theo, ratio[m_theo]):
+        theo[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0] / theo_norm[level]
     return float(np.mean(avar / theo)), n
 
 
