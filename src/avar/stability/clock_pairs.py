@@ -16,9 +16,9 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from avar._kernels.time_error import codev_levels
+from avar.stability.chi2 import CATALOGUE_QUANTILES, chi2_bounds
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options
-from avar.stability.edf import chi2_bounds
 from avar.stability.grids import grid_factors
 from avar.stability.time_error import check_alpha, level_noise, prepared_phase
 
@@ -107,7 +107,7 @@ def three_cornered_hat(ab: Any, bc: Any, ca: Any, rate: float = 1.0, data_type: 
             edf = np.where(positive, np.maximum(4 * variance**2 / noise, 1.0), np.nan)
         lci, uci = np.full(variance.size, np.nan), np.full(variance.size, np.nan)
         if positive.any():
-            lci[positive], uci[positive] = chi2_bounds(deviation[positive], edf[positive], float(confidence))
+            lci[positive], uci[positive] = chi2_bounds(deviation[positive], edf[positive], float(confidence), quantiles=CATALOGUE_QUANTILES)
         clocks.append(Deviation(
             taus=own.taus, averaging_factors=own.averaging_factors, deviation=deviation, variance=variance,
             n=own.n, alpha=own.alpha, edf=edf, lci=lci, uci=uci, estimator=own.estimator, data_type=own.data_type,

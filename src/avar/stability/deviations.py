@@ -33,6 +33,7 @@ import pandas as pd
 
 from avar._kernels.deviation_phase import scan
 from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, rate_from_index, short_repr
+from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_core import OctaveMoments, deviation_levels_and_phase
 from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors, levels_with_terms
 from avar.stability.deviation_results import Deviation
@@ -216,7 +217,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     edf = estimator_edf(estimator, alpha, factors, n_phase)
     if n_missing:
         edf = gap_scaled_edf(edf, n, estimator, n_phase, factors)
-    lci, uci = chi2_bounds(deviation, edf, float(confidence))
+    lci, uci = chi2_bounds(deviation, edf, float(confidence), quantiles=CATALOGUE_QUANTILES)
     return Deviation(
         taus=factors / rate, averaging_factors=factors, deviation=deviation, variance=variance, n=n,
         alpha=alpha, edf=edf, lci=lci, uci=uci, estimator=estimator, data_type=data_type, rate=rate,

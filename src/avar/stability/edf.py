@@ -3,7 +3,8 @@
 :func:`greenhall_edf` (Greenhall and Riley 2003: Allan d = 2, Hadamard d = 3,
 overlapping or not, modified or not), :func:`totdev_edf` (NIST SP 1065 Table
 7), :func:`estimator_edf` (by estimator name, per level) and
-:func:`chi2_bounds` (a variance estimate is sigma**2 chi2(edf) / edf).
+:func:`~avar.stability.chi2.chi2_bounds` (a variance estimate is sigma**2 chi2(edf) / edf;
+re-exported here).
 Everything is vectorized over the levels; Greenhall's sums are NumPy's for a few
 levels and compiled for many (:mod:`avar._kernels.edf`).
 """
@@ -16,9 +17,11 @@ from typing import Any
 import numpy as np
 
 from avar._validation import short_repr
+from avar.stability.chi2 import DEFAULT_CONFIDENCE, chi2_bounds
 
-#: Stable32's default confidence factor (about one standard deviation).
-DEFAULT_CONFIDENCE = 0.683
+__all__ = ["DEFAULT_CONFIDENCE", "EDF_ESTIMATORS", "ESTIMATORS", "J_MAX", "chi2_bounds", "estimator_edf", "gap_scaled_edf",
+           "greenhall_edf", "totdev_edf"]
+
 #: Greenhall's J_max: beyond it, tables or a summed stride replace the full sum.
 J_MAX = 100
 #: Estimator name -> (d, overlapping, modified) of Greenhall's algorithm.
@@ -289,69 +292,6 @@ def gap_scaled_edf(edf: np.ndarray, used: np.ndarray, estimator: str, n_phase: i
     from avar.stability.deviation_grids import term_counts
 
     return np.maximum(edf * used / term_counts(estimator, n_phase, factors), 1.0)
-
-
-def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE) -> tuple[np.ndarray, np.ndarray]:
-    """Chi-squared confidence bounds of a deviation with ``edf`` degrees of freedom.
-
-    With q the two-sided tail probability (1 - confidence) / 2::
-
-        lci = deviation sqrt(edf / chi2.isf(q, edf)),  uci = deviation sqrt(edf / chi2.ppf(q, edf))
-
-    (NIST SP 1065 eq. 45). The upper quantile comes from the survival function
-    so that confidences near 1 keep their precision. Both bounds are positive
-    for a positive deviation. At a low confidence (below about 0.4) the
-    central chi-squared interval lies around its median, below edf, and would
-    exclude the estimate itself: the bounds are then widened to the deviation,
-    so that lci <= deviation <= uci always (a wider, conservative interval).
-
-    Parameters
-    ----------
-    deviation : array_like of float
-        Deviations, >= 0.
-    edf : array_like of float
-        Equivalent degrees of freedom, > 0 (NaN gives NaN bounds); broadcast
-        against ``deviation``.
-    confidence : float
-        Two-sided confidence level in (0, 1); default 0.683 as Stable32.
-
-    Returns
-    -------
-    (lci, uci) : tuple of ndarray
-
-    Examples
-    --------
-    >>> lci, uci = chi2_bounds(0.2, 999.0)
-    >>> round(float(lci), 5), round(float(uci), 5)
-    (0.19567, 0.20463)
-    >>> [b.round(3).tolist() for b in chi2_bounds([1.0, 1.0], [1.0, 10.0], confidence=0.95)]
-    [[0.446, 0.699], [31.91, 1.755]]
-    >>> [b.round(3).tolist() for b in chi2_bounds([1.0], [1.0], confidence=0.1)]  # lci widened to the estimate
-    [[1.0], [1.673]]
-    """
-    from scipy.special import chdtri, gammaincinv  # what chi2.isf / chi2.ppf call, without their overhead
-
-    deviation, edf = _real_array(deviation, "deviation"), _real_array(edf, "edf")
-    if not (np.isfinite(deviation).all() and (deviation >= 0).all()):
-        raise ValueError(f"deviation must be finite and >= 0, got {short_repr(deviation)}")
-    if (edf <= 0).any() or np.isinf(edf).any():
-        raise ValueError(f"edf must be positive and finite (NaN allowed), got {short_repr(edf)}")
-    if isinstance(confidence, (bool, np.bool_)) or not isinstance(confidence, (int, float, np.integer, np.floating)) \
-            or not 0 < confidence < 1:
-        raise ValueError(f"confidence must be a number in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
-    tail = (1.0 - float(confidence)) / 2.0
-    # uci is inf only where the lower chi-squared quantile underflows (EDF << 1 at a confidence near 1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        upper, lower = chdtri(edf, tail), 2.0 * gammaincinv(edf / 2.0, tail)  # chi2.isf, chi2.ppf (tail, edf)
-        lci, uci = deviation * np.sqrt(edf / upper), deviation * np.sqrt(edf / lower)
-        return np.minimum(lci, deviation), np.maximum(uci, deviation)
-
-
-def _real_array(values: Any, name: str) -> np.ndarray:
-    array = np.asarray(values)
-    if array.dtype.kind not in "iuf" or isinstance(values, (bool, np.bool_)):
-        raise TypeError(f"{name} must be a real number or array, got {short_repr(values)}")
-    return array.astype(np.float64)
 
 
 def _check_count(n: Any, name: str) -> int:

@@ -18,6 +18,7 @@ import numpy as np
 
 from avar._kernels.stream import stream_update
 from avar._validation import check_freq, short_repr
+from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import term_counts
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DATA_TYPES, DEFAULT_CONFIDENCE, _check_data
@@ -127,7 +128,7 @@ class Stream:
         deviation = np.sqrt(variance)
         alpha = np.full(m.size, self.alpha, dtype=np.int64)
         edf = estimator_edf(self.statistic, alpha, m, self.n_phase)
-        lci, uci = chi2_bounds(deviation, edf, self.confidence)
+        lci, uci = chi2_bounds(deviation, edf, self.confidence, quantiles=CATALOGUE_QUANTILES)
         return Deviation(taus=tau, averaging_factors=m, deviation=deviation, variance=variance, n=n, alpha=alpha,
                          edf=edf, lci=lci, uci=uci, estimator=self.statistic, data_type=self.data_type,
                          rate=self.rate, n_samples=self.n_samples, confidence=self.confidence)

@@ -17,6 +17,7 @@ from avar._kernels.theo import lag_diagonals, oavar_expanded, oavar_sums, theo1_
 from avar._kernels.theo_fft import autocorrelation
 from avar._kernels.theo_levels import MAX_RATIO, theo1_sums
 from avar._kernels.total import theo1_sum
+from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import deviation_factors
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, noise_exponents
@@ -189,7 +190,7 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     if not np.all(np.isfinite(variance)):
         raise ValueError("theoh overflows float64; rescale the data, e.g. to other units")
     deviation = np.sqrt(variance)
-    lci, uci = chi2_bounds(deviation, edf, float(confidence))
+    lci, uci = chi2_bounds(deviation, edf, float(confidence), quantiles=CATALOGUE_QUANTILES)
     return Deviation(taus=np.concatenate((allan, 0.75 * theo)) / rate, averaging_factors=factors, deviation=deviation,
                      variance=variance, n=np.concatenate((n_phase - 2 * allan, counts * (theo // 2))), alpha=alphas, edf=edf,
                      lci=lci, uci=uci, estimator="theoh", data_type=data_type, rate=rate, n_samples=values.size,

@@ -17,6 +17,7 @@ import numpy as np
 
 from avar._kernels.time_error import mtie_levels, pdev_levels, tierms_levels
 from avar._validation import short_repr
+from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import levels_with_terms
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import _check_data, _check_options, _noise_of_levels, noise_exponents
@@ -111,7 +112,7 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         edf = pdev_edf(alpha_levels, factors, n_phase)
         if gaps[-1]:
             edf = gap_scaled_edf(edf, n, "oadev", n_phase, factors)
-        lci, uci = chi2_bounds(deviation, edf, float(confidence))
+        lci, uci = chi2_bounds(deviation, edf, float(confidence), quantiles=CATALOGUE_QUANTILES)
     else:
         edf = lci = uci = np.full(factors.size, np.nan)
     return Deviation(

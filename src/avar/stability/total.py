@@ -19,11 +19,11 @@ import numpy as np
 
 from avar._kernels.theo_levels import theo1_sums
 from avar._kernels.total import level_sums, theo1_sum
+from avar.stability.chi2 import CATALOGUE_QUANTILES, chi2_bounds
 from avar.stability.deviation_core import phase_parts
 from avar.stability.deviation_grids import levels_with_terms
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options, noise_exponents
-from avar.stability.edf import chi2_bounds
 from avar.stability.total_edf import (
     MTOT_EDF,
     htot_bias,
@@ -165,7 +165,7 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
     if bad.size:
         edf = np.maximum(edf * n / term_counts(estimator, n_phase, factors), 1.0)
     deviation = np.sqrt(variance)
-    lci, uci = chi2_bounds(deviation, edf, float(confidence))
+    lci, uci = chi2_bounds(deviation, edf, float(confidence), quantiles=CATALOGUE_QUANTILES)
     return Deviation(taus=tau, averaging_factors=factors, deviation=deviation, variance=variance, n=n, alpha=alphas,
                      edf=edf, lci=lci, uci=uci, estimator=estimator, data_type=data_type, rate=rate,
                      n_samples=values.size, confidence=float(confidence))

@@ -124,16 +124,21 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
 
     * MTOTDEV, TTOTDEV: the modified Allan variance's (Greenhall) below m = 10,
       as Stable32; from m = 10 b N / m - c (NIST SP 1065, Table 8). Stable32's
-      bounds there follow another law (PHASE.DAT: about 4/3 (N - 1) / m - 1.89 for
-      white FM, 1.73 (N - 1) / m - 2.99 for flicker PM, none published): ours are up
-      to 2 % (white FM) and 5 % (flicker PM) narrower.
+      bounds there imply another law (PHASE.DAT: 4/3 (N - 1) / m - 1.89 for white
+      FM, 1.734 (N - 1) / m - 2.99 for flicker PM, none published), 20 to 50 %
+      more degrees of freedom than simulated records show, where Table 8 is
+      within 5 % (m <= 64) to 20 % (``benchmarks/total_edf_simulation.py``): the
+      bounds here are up to 2 % (white FM) and 6 % (flicker PM) wider than
+      Stable32's.
     * HTOTDEV: the overlapping Hadamard variance's (Greenhall) below m = 16
       and for white and flicker PM; from m = 16 (Stable32)
       (N / m) / (b0 + b1 m / N) with (b0, b1) = (0.559, 1.004), (0.868,
       1.140), (0.938, 1.696) for alpha = 0, -1, -2. Stable32's EDF is higher
-      below m = 16 (PHASE.DAT, white FM: 676, 579, 352, 187 at m = 1 .. 8 against
-      608, 452, 257, 140; no published formula gives them) and for white PM (about
-      the Allan variance's (N + 1)(N - 2m) / (2 (N - m))): bounds within 1 %.
+      below m = 16 (PHASE.DAT, white FM: 669, 572, 349, 184 at m = 1 .. 8 against
+      609, 452, 257, 140; no published formula gives them) and for flicker PM;
+      simulated records have more still (597, 385, 208 at m = 2, 4, 8), so the
+      bounds here are conservative: up to 1 % wider than Stable32's at white FM,
+      3 % at flicker PM.
     * Theo1 (Howe and Tasset 2004; NIST SP 1065, Table 11), r = 0.75 m:
       alpha = 2: 0.86 (N + 1)(N - 4r/3) / (N - r) * r / (r + 1.14);
       1: (4.798 N**2 - 6.374 N r + 12.387 r) / (sqrt(r + 36.6) (N - r)) * r / (r + 0.3);
