@@ -67,22 +67,17 @@ def test_stable32_quantiles_print_stable32s_bounds(name):
 def test_wilson_hilferty_with_stable32s_normal_quantile():
     # chi2_p(nu) = nu (1 - 2/(9 nu) + z sqrt(2/(9 nu)))^3 with Abramowitz-Stegun 26.2.22 for z,
     # a1 = 0.27601 (Stable32) instead of the handbook's 0.27061, written out here from the formulas
-    def quantile(p_upper, nu):
-        t = np.sqrt(np.log(1.0 / p_upper**2))
-        z = t - (2.30753 + 0.27601 * t) / (1.0 + 0.99229 * t + 0.04481 * t**2)
-        return nu * (1.0 - 2.0 / (9.0 * nu) + z * np.sqrt(2.0 / (9.0 * nu))) ** 3
-
-    def quantile_lower(p_lower, nu):
-        t = np.sqrt(np.log(1.0 / p_lower**2))
-        z = -(t - (2.30753 + 0.27601 * t) / (1.0 + 0.99229 * t + 0.04481 * t**2))
+    def quantile(p, nu, side):  # side +1: the upper tail p, -1: the lower tail p
+        t = np.sqrt(np.log(1.0 / p**2))
+        z = side * (t - (2.30753 + 0.27601 * t) / (1.0 + 0.99229 * t + 0.04481 * t**2))
         return nu * (1.0 - 2.0 / (9.0 * nu) + z * np.sqrt(2.0 / (9.0 * nu))) ** 3
 
     for nu in (100.5, 250.0, 999.0, 5e4):
         for confidence in (0.683, 0.9, 0.95):
             tail = (1 - confidence) / 2
             lci, uci = chi2_bounds(2.0, nu, confidence, quantiles="stable32")
-            assert lci == pytest.approx(2.0 * np.sqrt(nu / quantile(tail, nu)), rel=1e-14)
-            assert uci == pytest.approx(2.0 * np.sqrt(nu / quantile_lower(tail, nu)), rel=1e-14)
+            assert lci == pytest.approx(2.0 * np.sqrt(nu / quantile(tail, nu, +1)), rel=1e-14)
+            assert uci == pytest.approx(2.0 * np.sqrt(nu / quantile(tail, nu, -1)), rel=1e-14)
             # within 5e-4 of the exact bounds
             assert lci == pytest.approx(2.0 * np.sqrt(nu / chi2.isf(tail, nu)), rel=5e-4)
             assert uci == pytest.approx(2.0 * np.sqrt(nu / chi2.ppf(tail, nu)), rel=5e-4)
