@@ -23,15 +23,16 @@ costs O(m) and a level O(N m). Theo1 always takes the direct loop here,
 O(N m / 2) per level (:mod:`avar.stability.total` sends its long gap-free levels
 to :mod:`avar._kernels.theo_levels`). A level's terms run in tasks of
 :data:`CHUNK` terms whose sums are added in task order; large levels run the
-tasks on every thread (numba's ``prange``) with the same result as the serial
-loop.
+tasks on every thread (:func:`avar._kernels.tasks.run_ranges`) with the same result
+as the serial loop.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
+from avar._kernels.tasks import run_ranges
 from avar._kernels.total_blocks import level_sum
 
 
@@ -158,24 +159,36 @@ def _level_serial(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift:
     return total, count
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def _level_parallel(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int,
+def _level_threaded(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int,
                     n_terms: int) -> tuple[float, int]:
-    """:func:`_level_serial` with the tasks spread over the threads; their sums are added in
-    task order, so the result is the same on any number of threads."""
+    """:func:`_level_serial` with its tasks spread over the threads (:mod:`avar._kernels.tasks`);
+    their sums are added in task order, so the result is the same on any number of threads."""
     n_tasks = (n_terms + CHUNK - 1) // CHUNK
     sums = np.zeros(n_tasks)
     counts = np.zeros(n_tasks, dtype=np.int64)
-    for task in prange(n_tasks):
-        first = task * CHUNK
-        sums[task], counts[task] = _window_range(kind, values, m, bad, shift, first,
-                                                 min(n_terms, first + CHUNK))
+
+    def tasks(first_task: int, stop_task: int) -> None:
+        sums[first_task:stop_task], counts[first_task:stop_task] = _task_range(
+            kind, values, m, bad, shift, n_terms, first_task, stop_task)
+
+    run_ranges(n_tasks, tasks)
     total = 0.0
-    count = 0
-    for task in range(n_tasks):
-        total += sums[task]
-        count += counts[task]
-    return total, count
+    for part in sums.tolist():  # in task order, as the serial loop adds them
+        total += part
+    return total, int(counts.sum())
+
+
+@njit(cache=True, nogil=True)
+def _task_range(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, n_terms: int,
+                first_task: int, stop_task: int) -> tuple[np.ndarray, np.ndarray]:
+    """The sums and counts of tasks ``first_task .. stop_task - 1`` (of :data:`CHUNK` terms each)."""
+    sums = np.zeros(stop_task - first_task)
+    counts = np.zeros(stop_task - first_task, dtype=np.int64)
+    for task in range(first_task, stop_task):
+        first = task * CHUNK
+        sums[task - first_task], counts[task - first_task] = _window_range(
+            kind, values, m, bad, shift, first, min(n_terms, first + CHUNK))
+    return sums, counts
 
 
 #: Levels with more window points than this (terms x window length) run on every thread.
@@ -202,7 +215,7 @@ def _level(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, n
             return level_sum(values, m, clean), used
     work = n_terms * m * (1 if kind == 2 else 3)
     if work > PARALLEL_WORK and n_terms > CHUNK:
-        return _level_parallel(kind, values, m, bad, shift, n_terms)
+        return _level_threaded(kind, values, m, bad, shift, n_terms)
     return _level_serial(kind, values, m, bad, shift, n_terms)
 
 
