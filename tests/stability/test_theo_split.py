@@ -10,6 +10,7 @@ from avar._kernels.theo import oavar_sums
 from avar._kernels.theo_fft import autocorrelation, short_autocorrelation
 from avar._kernels.theo_split import crossing_terms, groups, knot_profile, split_record
 from avar._kernels.total import theo1_sum
+from avar.stability import theo
 
 NO_GAPS = np.zeros(0, dtype=np.int64)
 
@@ -157,3 +158,22 @@ def test_theo1_sums_split_ill_conditioned_levels_and_sum_the_rest_directly(monke
     assert expanded < factors.size and calls
     np.testing.assert_allclose(sums, direct, rtol=1e-11)
 
+
+def test_theobr_terms_of_random_walk_fm_equal_the_direct_ones(monkeypatch):
+    """kf's OAVAR and Theo1 sums: the ill-conditioned ones by the split (kf within 1e-11 of the
+    all-direct mean at a tolerance of 1e-12), and no direct sum at the default tolerance."""
+    x = noises(4000, seed=11)["random-walk FM"]
+    calls = []
+    monkeypatch.setattr(theo, "theo1_sum", lambda *args: calls.append(args[1]) or theo1_sum(*args))
+    monkeypatch.setattr(theo, "oavar_sums", lambda v, m: calls.extend(m.tolist()) or oavar_sums(v, m))
+    terms, n = theo.theobr_terms(x)
+    assert not calls
+    i = np.arange(n + 1)
+    m_avar, m_theo = 9 + 3 * i, 12 + 4 * i
+    avar = oavar_sums(x, m_avar) / (2.0 * m_avar**2 * (x.size - 2 * m_avar))
+    theo1 = np.array([theo1_sum(x, int(m), NO_GAPS, 0)[0] for m in m_theo]) / (0.75 * (x.size - m_theo) * m_theo**2)
+    assert np.mean(terms) == pytest.approx(np.mean(avar / theo1), rel=1e-8)
+    monkeypatch.setattr(theo, "KF_TOLERANCE", 1e-12)
+    terms, n = theo.theobr_terms(x)
+    assert np.mean(terms) == pytest.approx(np.mean(avar / theo1), rel=1e-11)
+    np.testing.assert_allclose(terms[:20], (avar / theo1)[:20], rtol=1e-10)  # the smallest m: split or direct
