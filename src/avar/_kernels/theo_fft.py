@@ -33,6 +33,34 @@ def autocorrelation(x: np.ndarray) -> np.ndarray:
     return fft.irfft(spectrum.real**2 + spectrum.imag**2, size)[:n]
 
 
+#: Fewest points of an FFT of :func:`short_autocorrelation` (shorter ones cost more per point).
+_SHORT_FFT = 1 << 13
+
+
+def short_autocorrelation(x: np.ndarray, count: int) -> np.ndarray:
+    """F[L] = sum_{p=0}^{N-1-L} x_p x_{p+L} for L = 0 .. ``count`` - 1 only, in blocks.
+
+    The points p go in blocks of B; a block's products are the correlation of its B points
+    with the B + count - 1 from its start (0 past the end), one FFT of size >= B + count - 1
+    each (all blocks in one batch), summed over the blocks in order. O(N log count) for
+    count << N, against O(N log N) for :func:`autocorrelation`."""
+    n = x.shape[0]
+    count = min(int(count), n)
+    size = fft.next_fast_len(max(4 * count, _SHORT_FFT), real=True)
+    block = size - count + 1
+    if 2 * block >= n:
+        return autocorrelation(x)[:count]
+    n_blocks = -(-n // block)
+    padded = np.zeros(n_blocks * block + size)
+    padded[:n] = x
+    windows = np.lib.stride_tricks.as_strided(padded, (n_blocks, size), (block * padded.itemsize, padded.itemsize),
+                                              writeable=False)
+    heads = np.zeros((n_blocks, size))
+    heads[:, :block] = padded[: n_blocks * block].reshape(n_blocks, block)
+    spectrum = fft.rfft(windows, axis=1) * np.conj(fft.rfft(heads, axis=1))
+    return fft.irfft(spectrum, size, axis=1)[:, :count].sum(axis=0)
+
+
 def _blocks(count: int) -> tuple[int, int]:
     """(leaf, length): length = leaf * 2**k >= count with the smallest such length."""
     best = None

@@ -19,9 +19,12 @@ The head sums over a are, with AC_k the autocorrelation of x[:k]:
 
 So a level costs two FFT autocorrelations of each end and O(m) sums. The
 expansion loses digits where the terms are much larger than S (strongly
-correlated phase at small m): :func:`theo1_expanded` returns that ratio and
-:func:`theo1_sums` sums such levels directly. No validation; gap-free,
-detrended x.
+correlated phase at small m): :func:`theo1_expanded` returns that ratio, and
+:func:`theo1_sums` gives such levels to :func:`split_sums`, the same expansion
+of the record less a broken line (:mod:`avar._kernels.theo_split`: the terms
+then scale with the wander between knots about m apart, not over the record),
+and sums directly only a level that is ill-conditioned even so. No validation;
+gap-free, detrended x.
 """
 
 from __future__ import annotations
@@ -30,8 +33,9 @@ import numpy as np
 from numba import njit
 from scipy import fft
 
-from avar._kernels.theo import lag_diagonals, theo1_every
-from avar._kernels.theo_fft import autocorrelation, phi_sums
+from avar._kernels.theo import lag_diagonals, oavar_expanded, theo1_every
+from avar._kernels.theo_fft import autocorrelation, phi_sums, short_autocorrelation
+from avar._kernels.theo_split import combine, groups, split_parts
 
 #: Levels with fewer inner terms than this are summed directly (cheaper than the FFTs).
 DIRECT_TERMS = 1 << 22
@@ -41,6 +45,9 @@ EVERY_LEVELS = 64
 #: Above this ratio of the expansion's largest terms to the result it may have lost
 #: more than about 1e-11 (relative): the level is summed directly instead.
 MAX_RATIO = 1e4
+#: A split group of :func:`theo1_sums` takes the factors down to 1 / SPLIT_REACH of its knot spacing
+#: (random-walk FM: ratio about 5 at the spacing, 1e3 at 1 / 8 of it).
+SPLIT_REACH = 8
 
 
 @njit(cache=True)
@@ -87,11 +94,13 @@ def _end_autocorrelation(x: np.ndarray, reverse: np.ndarray, k: int) -> np.ndarr
     return fft.irfft(head.real**2 + head.imag**2 + tail.real**2 + tail.imag**2, size)[:k]
 
 
-def prepare(x: np.ndarray, h_max: int) -> tuple:
-    """What every level shares: x reversed, running sum of x^2, F, Φ of both ends up to ``h_max``."""
+def prepare(x: np.ndarray, h_max: int, autocorr: np.ndarray | None = None) -> tuple:
+    """What every level shares: x reversed, running sum of x^2, F (``autocorr`` if given), Φ of
+    both ends up to ``h_max``."""
     reverse = np.ascontiguousarray(x[::-1])
     squares = np.concatenate(([0.0], np.cumsum(x * x)))
-    return (x, reverse, squares, autocorrelation(x), phi_sums(x, h_max + 1), phi_sums(reverse, h_max + 1))
+    autocorr = autocorrelation(x) if autocorr is None else autocorr
+    return (x, reverse, squares, autocorr, phi_sums(x, h_max + 1), phi_sums(reverse, h_max + 1))
 
 
 def theo1_expanded(prepared: tuple, m: int) -> tuple[float, float]:
@@ -107,11 +116,50 @@ def theo1_expanded(prepared: tuple, m: int) -> tuple[float, float]:
     return total, ratio
 
 
+def split_sums(x: np.ndarray, factors: np.ndarray, reach: float,
+               allan: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+    """Theo1's double sums at the even ``factors`` by the broken-line split of
+    :mod:`avar._kernels.theo_split` and each one's ratio (as :func:`theo1_expanded`), then the
+    overlapping Allan sums at the factors ``allan`` (span 2m; none by default) and their ratios
+    (as :func:`avar._kernels.theo.oavar_expanded`).
+
+    The spans go in groups (:func:`avar._kernels.theo_split.groups`): one split per group, its
+    knot spacing the group's largest span, S(r) by :func:`theo1_expanded` per level or, for
+    :data:`EVERY_LEVELS` Theo1 levels or more, by :func:`avar._kernels.theo.theo1_every`; F of r
+    only up to the spacing (:func:`avar._kernels.theo_fft.short_autocorrelation`)."""
+    factors = np.asarray(factors, dtype=np.int64)
+    allan = np.zeros(0, dtype=np.int64) if allan is None else np.asarray(allan, dtype=np.int64)
+    spans = np.concatenate((factors, 2 * allan))
+    sums = np.empty(spans.size)
+    ratios = np.empty(spans.size)
+    for spacing, members in groups(spans, reach):
+        parts = split_parts(x, spacing)
+        r = parts[0]
+        autocorr = short_autocorrelation(r, spacing + 1)  # lags up to the spacing only
+        theo, pairs = members[members < factors.size], members[members >= factors.size]
+        diagonals = None
+        if theo.size >= EVERY_LEVELS or pairs.size:
+            diagonals = lag_diagonals(r, np.ascontiguousarray(r[::-1]), spacing // 2 + 1)
+        if theo.size >= EVERY_LEVELS:
+            every, every_ratio = theo1_every(r, spacing, autocorr, diagonals)
+            rest, rest_ratio = every[spans[theo]], every_ratio[spans[theo]]
+        elif theo.size:
+            prepared = prepare(r, spacing // 2, autocorr)
+            rest, rest_ratio = np.array([theo1_expanded(prepared, int(m)) for m in spans[theo]]).reshape(-1, 2).T
+        if theo.size:
+            sums[theo], ratios[theo] = combine(rest, rest_ratio, parts, spacing, spans[theo])
+        if pairs.size:
+            rest, rest_ratio = oavar_expanded(r, spans[pairs] // 2, autocorr, diagonals)
+            sums[pairs], ratios[pairs] = combine(rest, rest_ratio, parts, spacing, spans[pairs], allan=True)
+    return sums[: factors.size], ratios[: factors.size], sums[factors.size :], ratios[factors.size :]
+
+
 def theo1_sums(x: np.ndarray, factors: np.ndarray, direct) -> tuple[np.ndarray, int]:
     """Theo1's double sums of gap-free ``x`` at the even ``factors``: directly (``direct(x, m)``)
-    where that is cheap or the expansion ill-conditioned, else by :func:`theo1_expanded`
-    (or :func:`avar._kernels.theo.theo1_every` for :data:`EVERY_LEVELS` levels or more).
-    Returns the sums and how many levels took the expansion."""
+    where that is cheap, else by :func:`theo1_expanded` (or :func:`avar._kernels.theo.theo1_every`
+    for :data:`EVERY_LEVELS` levels or more); a level whose ratio exceeds :data:`MAX_RATIO` by
+    :func:`split_sums` instead, and directly if it still does. Returns the sums and how many
+    levels took an expansion (whole or split)."""
     n_points = x.shape[0]
     sums = np.empty(factors.shape[0])
     long = np.array([(n_points - m) * (m // 2) > DIRECT_TERMS for m in factors.tolist()], dtype=bool)
@@ -123,12 +171,23 @@ def theo1_sums(x: np.ndarray, factors: np.ndarray, direct) -> tuple[np.ndarray, 
     elif long.any():
         prepared = prepare(x, int(factors[long].max()) // 2)
     expanded = 0
+    retry = []
     for level, m in enumerate(factors.tolist()):
         if long[level]:
             total, ratio = (every[0][m], every[1][m]) if every is not None else theo1_expanded(prepared, m)
             if ratio <= MAX_RATIO:
                 sums[level] = total
                 expanded += 1
-                continue
+            else:
+                retry.append(level)
+            continue
         sums[level] = direct(x, m)
+    if retry:
+        split, ratios = split_sums(x, factors[retry], SPLIT_REACH)[:2]
+        for level, total, ratio in zip(retry, split.tolist(), ratios.tolist()):
+            if ratio <= MAX_RATIO:
+                sums[level] = total
+                expanded += 1
+            else:
+                sums[level] = direct(x, int(factors[level]))
     return sums, expanded

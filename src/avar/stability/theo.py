@@ -15,7 +15,7 @@ import numpy as np
 
 from avar._kernels.theo import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
 from avar._kernels.theo_fft import autocorrelation
-from avar._kernels.theo_levels import MAX_RATIO, theo1_sums
+from avar._kernels.theo_levels import MAX_RATIO, split_sums, theo1_sums
 from avar._kernels.total import theo1_sum
 from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import deviation_factors
@@ -33,6 +33,9 @@ ERROR_PER_RATIO = 1e-14
 #: Relative error allowed in TheoBR's kf from the expanded Theo1 sums of its average (kf is
 #: an estimate whose own statistical uncertainty is of order 1e-2; ThêoH prints 5 digits).
 KF_TOLERANCE = 1e-8
+#: The split groups of kf's ill-conditioned Theo1 sums reach down to 1 / KF_REACH of their knot
+#: spacing (ratio up to about 1e4 on random-walk FM: 1e-10, far below kf's tolerance).
+KF_REACH = 16
 
 
 def theobr_factor(x: np.ndarray) -> tuple[float, int]:
@@ -41,25 +44,50 @@ def theobr_factor(x: np.ndarray) -> tuple[float, int]:
 
     ``x``: gap-free phase, N >= 90 points. The units cancel in the ratio.
     """
+    terms, n = theobr_terms(x)
+    return float(np.mean(terms)), n
+
+
+def theobr_terms(x: np.ndarray) -> tuple[np.ndarray, int]:
+    """The n + 1 terms AVAR(9 + 3i) / Theo1(12 + 4i) of :func:`theobr_factor`'s mean, and n.
+
+    OAVAR and Theo1 sums by FFT (:func:`avar._kernels.theo.oavar_expanded`, :func:`theo1_every`);
+    the ill-conditioned ones by the split expansion (:func:`avar._kernels.theo_levels.split_sums`:
+    OAVAR's above :data:`MAX_RATIO`, Theo1's as far as kf's tolerance needs, see
+    :func:`_levels_to_redo`), and directly if that is not enough either."""
     n_points = x.shape[0]
     n = int(np.floor(0.1 * n_points / 3.0)) - 3
     i = np.arange(n + 1, dtype=np.int64)
     m_avar = 9 + 3 * i
     m_theo = 12 + 4 * i
-    # lag sums by FFT; each sum is checked and redone directly if ill-conditioned
     autocorr = autocorrelation(x)
     diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), int(m_avar[-1]) + 1)
     avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
-    redo = avar_ratio > MAX_RATIO
-    avar_sums[redo] = oavar_sums(x, m_avar[redo])
+    redo = np.flatnonzero(avar_ratio > MAX_RATIO)  # by the split expansion, then directly
+    if redo.size:
+        _take_better(avar_sums, avar_ratio, redo, *split_sums(x, np.zeros(0), KF_REACH, m_avar[redo])[2:])
+        redo = redo[avar_ratio[redo] > MAX_RATIO]
+        avar_sums[redo] = oavar_sums(x, m_avar[redo])
+    avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
     every, ratio = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
     theo_norm = 0.75 * (n_points - m_theo) * m_theo * m_theo
-    theo = every[m_theo] / theo_norm
-    avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
+    sums, ratio = every[m_theo], ratio[m_theo]
+    split = _levels_to_redo(avar * theo_norm / sums, ratio)  # first by the split expansion
+    if split.size:
+        _take_better(sums, ratio, split, *split_sums(x, m_theo[split], KF_REACH)[:2])
+    theo = sums / theo_norm
     no_gaps = np.zeros(0, dtype=np.int64)
-    for level in _levels_to_redo(avar / theo, ratio[m_theo]):
+    for level in _levels_to_redo(avar / theo, ratio):
         theo[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0] / theo_norm[level]
-    return float(np.mean(avar / theo)), n
+    return avar / theo, n
+
+
+def _take_better(sums: np.ndarray, ratio: np.ndarray, levels: np.ndarray, new: np.ndarray,
+                 new_ratio: np.ndarray) -> None:
+    """Replace ``sums`` and ``ratio`` at ``levels`` by ``new`` where its ratio is lower."""
+    better = new_ratio < ratio[levels]
+    sums[levels[better]] = new[better]
+    ratio[levels[better]] = new_ratio[better]
 
 
 def _levels_to_redo(terms: np.ndarray, ratio: np.ndarray) -> np.ndarray:
@@ -119,11 +147,12 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     identified by the OADEV rules (at 0.75 m for Theo1 levels) or fixed by
     ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. kf needs Theo1 at every m = 2 .. N / 7.5
     and OAVAR at N / 30 factors, all at once from FFT autocorrelations in O(N log N)
-    (:func:`avar._kernels.theo.theo1_every`); a sum whose expansion is ill-conditioned
-    is summed directly, exactly but in O(N m): every
-    displayed Theo1 level whose expansion may err by more than about 1e-10, and of kf's
-    average the worst-conditioned levels until kf itself is good to 1e-8 (random-walk FM:
-    the smallest m; at N = 1e5 about 50 of 3,300 levels). ``n``: N - 2m
+    (:func:`avar._kernels.theo.theo1_every`). Where that expansion is ill-conditioned
+    (wandering phase: random-walk FM) the sums come from the same expansion of the record
+    less a broken line (:mod:`avar._kernels.theo_split`, O(N log N) per group of factors):
+    every displayed Theo1 level and OAVAR sum whose whole-record expansion may err by more
+    than about 1e-10, and of kf's Theo1 sums the worst-conditioned until kf itself is good
+    to 1e-8; a sum still ill-conditioned then is summed directly (O(N m)). ``n``: N - 2m
     (OADEV), (N - m) m / 2 (Theo1, as Stable32). Dimensionless.
 
     Parameters
