@@ -154,12 +154,14 @@ def split_sums(x: np.ndarray, factors: np.ndarray, reach: float,
     return sums[: factors.size], ratios[: factors.size], sums[factors.size :], ratios[factors.size :]
 
 
-def theo1_sums(x: np.ndarray, factors: np.ndarray, direct) -> tuple[np.ndarray, int]:
+def theo1_sums(x: np.ndarray, factors: np.ndarray, direct,
+               autocorr: np.ndarray | None = None) -> tuple[np.ndarray, int]:
     """Theo1's double sums of gap-free ``x`` at the even ``factors``: directly (``direct(x, m)``)
     where that is cheap, else by :func:`theo1_expanded` (or :func:`avar._kernels.theo.theo1_every`
     for :data:`EVERY_LEVELS` levels or more); a level whose ratio exceeds :data:`MAX_RATIO` by
-    :func:`split_sums` instead, and directly if it still does. Returns the sums and how many
-    levels took an expansion (whole or split)."""
+    :func:`split_sums` instead, and directly if it still does. ``autocorr``: x's
+    :func:`~avar._kernels.theo_fft.autocorrelation` if the caller has it. Returns the sums and
+    how many levels took an expansion (whole or split)."""
     n_points = x.shape[0]
     sums = np.empty(factors.shape[0])
     long = np.array([(n_points - m) * (m // 2) > DIRECT_TERMS for m in factors.tolist()], dtype=bool)
@@ -167,9 +169,9 @@ def theo1_sums(x: np.ndarray, factors: np.ndarray, direct) -> tuple[np.ndarray, 
     if long.sum() >= EVERY_LEVELS:
         largest = int(factors[long].max())
         diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), largest // 2 + 1)
-        every = theo1_every(x, largest, autocorrelation(x), diagonals)
+        every = theo1_every(x, largest, autocorrelation(x) if autocorr is None else autocorr, diagonals)
     elif long.any():
-        prepared = prepare(x, int(factors[long].max()) // 2)
+        prepared = prepare(x, int(factors[long].max()) // 2, autocorr)
     expanded = 0
     retry = []
     for level, m in enumerate(factors.tolist()):

@@ -42,17 +42,18 @@ KF_REACH = 16
 KF_ALLAN_REACH = 8
 
 
-def theobr_factor(x: np.ndarray) -> tuple[float, int]:
+def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[float, int]:
     """TheoBR's bias factor kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(9 + 3i) / Theo1(12 + 4i),
     n = floor(0.1 N / 3) - 3 (both at tau = (9 + 3i) tau0; AVAR overlapping), and n.
 
-    ``x``: gap-free phase, N >= 90 points. The units cancel in the ratio.
+    ``x``: gap-free phase, N >= 90 points; ``autocorr``: its FFT autocorrelation, if at hand.
+    The units cancel in the ratio.
     """
-    terms, n = theobr_terms(x)
+    terms, n = theobr_terms(x, autocorr)
     return float(np.mean(terms)), n
 
 
-def theobr_terms(x: np.ndarray) -> tuple[np.ndarray, int]:
+def theobr_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[np.ndarray, int]:
     """The n + 1 terms AVAR(9 + 3i) / Theo1(12 + 4i) of :func:`theobr_factor`'s mean, and n.
 
     OAVAR and Theo1 sums by FFT (:func:`avar._kernels.theo.oavar_expanded`, :func:`theo1_every`);
@@ -64,7 +65,7 @@ def theobr_terms(x: np.ndarray) -> tuple[np.ndarray, int]:
     i = np.arange(n + 1, dtype=np.int64)
     m_avar = 9 + 3 * i
     m_theo = 12 + 4 * i
-    autocorr = autocorrelation(x)
+    autocorr = autocorrelation(x) if autocorr is None else autocorr
     diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), int(m_avar[-1]) + 1)
     avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
     redo = np.flatnonzero(avar_ratio > MAX_RATIO)  # by the split expansion, then directly
@@ -202,13 +203,14 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     if n_phase < MIN_THEOH_POINTS:
         raise ValueError(f"data has {values.size} sample(s); theoh needs at least {MIN_THEOH_POINTS} phase points "
                          f"(TheoBR averages AVAR/Theo1 over floor(N / 30) - 2 taus)")
-    kf, _ = theobr_factor(x)
+    autocorr = autocorrelation(x)  # shared by kf and the displayed Theo1 levels
+    kf, _ = theobr_factor(x, autocorr)
     k = float(switch) * n_phase  # in samples
     allan, theo = _levels(n_phase, rate, taus, k)
     unit = rate * rate if data_type == "phase" else 1.0
     avar = oavar_sums(x, allan) / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit
     no_gaps = np.zeros(0, dtype=np.int64)
-    sums = theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0)[0])[0]
+    sums = theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0)[0], autocorr)[0]
     counts = n_phase - theo
     theobr = kf * sums / (0.75 * counts * theo * theo) / scale / scale * unit
     factors = np.concatenate((allan, theo))
