@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import allantools
 import numpy as np
 import pandas as pd
@@ -24,6 +26,11 @@ def power_law(kind: str, n: int, seed: int) -> np.ndarray:
     return avar.FN(1.0).simulate(n, seed=seed)
 
 
+def raw(estimator):
+    """The raw statistic, as its definition: TOTDEV without the removal of TOTVAR's bias."""
+    return {"bias_correction": False} if estimator == "totdev" else {}
+
+
 def allantools_result(estimator, data, data_type, taus):
     return getattr(allantools, estimator)(data, rate=RATE, data_type=data_type, taus=taus)
 
@@ -37,7 +44,7 @@ def test_equals_allantools(estimator, n, kind):
     data = power_law(kind, n, seed=n) * 1e-9
     for data_type in ("freq", "phase"):
         taus = "all" if n <= 1000 else "octave"
-        ours = getattr(avar, estimator)(data, rate=RATE, data_type=data_type, taus=taus)
+        ours = getattr(avar, estimator)(data, rate=RATE, data_type=data_type, taus=taus, **raw(estimator))
         t, dev, _, ns = allantools_result(estimator, data, data_type, taus)
         common = np.isin(ours.taus, t)
         assert np.array_equal(ours.taus[common], t)
@@ -84,7 +91,7 @@ def test_exact_arithmetic_on_adversarial_data(estimator, case):
     for data_type in ("freq", "phase"):
         if estimator not in ("hdev", "ohdev") and case.startswith("quadratic") and data_type == "phase":
             continue  # not cancellation-prone: the quadratic dominates the second differences
-        res = getattr(avar, estimator)(data, rate=3.0, data_type=data_type, taus="all")
+        res = getattr(avar, estimator)(data, rate=3.0, data_type=data_type, taus="all", **raw(estimator))
         for m, variance, n in zip(res.averaging_factors[::3], res.variance[::3], res.n[::3]):
             expected, count = exact_variance(estimator, data, int(m), data_type, 3.0)
             assert n == count
@@ -94,7 +101,7 @@ def test_exact_arithmetic_on_adversarial_data(estimator, case):
 @pytest.mark.parametrize("estimator", ESTIMATORS)
 def test_fsum_loop_larger(estimator):
     data = 5.0 + power_law("flicker", 600, seed=3)
-    res = getattr(avar, estimator)(data, data_type="freq", taus=[1, 7, 64, 150])
+    res = getattr(avar, estimator)(data, data_type="freq", taus=[1, 7, 64, 150], **raw(estimator))
     for m, variance, n in zip(res.averaging_factors, res.variance, res.n):
         expected, count = fsum_variance(estimator, data, int(m), "freq")
         assert n == count
@@ -222,7 +229,7 @@ def test_nan_omit_matches_the_definition(estimator, data_type):
     rng = np.random.default_rng(9)
     data = 3.0 + rng.standard_normal(60)
     data[[0, 17, 18, 41]] = np.nan
-    res = getattr(avar, estimator)(data, data_type=data_type, taus="all", nan_policy="omit")
+    res = getattr(avar, estimator)(data, data_type=data_type, taus="all", nan_policy="omit", **raw(estimator))
     for m, variance, n in zip(res.averaging_factors, res.variance, res.n):
         expected, count = exact_variance(estimator, data, int(m), data_type)
         assert n == count > 0
@@ -262,3 +269,26 @@ def test_gap_scaled_edf_never_falls_below_one_degree_of_freedom():
                    avar.avar(y, type="to", taus="all", nan_policy="omit", ci="chi2")):
         assert result.edf.min() == 1.0
         assert np.isfinite(result.uci).all() and (result.lci > 0).all()
+
+
+# Stable32, pink_frequency.txt (flicker FM, 10,000 frequency points, tau0 = 42 s), TOTDEV with the noise
+# identified (allantools' tests/pink_frequency/totdev.txt): AF, alpha, Total Sigma.
+STABLE32_PINK_TOTDEV = [(1, -1, 1.4064e-07), (2, -2, 1.3636e-07), (16, -2, 1.3668e-07), (33, -2, 1.3507e-07),
+                        (46, -1, 1.3697e-07), (48, 0, 1.3697e-07), (2369, 0, 3.0657e-08)]
+
+
+def test_totdev_removes_totvars_bias_as_stable32():
+    """Stable32 divides TOTVAR by 1 - a m / N at flicker (a = 1 / 3 ln 2) and random-walk FM (3 / 4):
+    its printed values, which the raw statistic misses by up to 1.2e-3 here."""
+    y = np.loadtxt(Path(__file__).parents[1] / "data" / "stable32" / "pink_frequency.txt")
+    rows = np.array(STABLE32_PINK_TOTDEV)
+    res = avar.totdev(y, rate=1 / 42, taus=rows[:, 0] * 42)
+    plain = avar.totdev(y, rate=1 / 42, taus=rows[:, 0] * 42, bias_correction=False)
+    assert res.alpha.tolist() == rows[:, 1].astype(int).tolist()
+    np.testing.assert_allclose(res.deviation, rows[:, 2], rtol=3e-5)  # Stable32 prints 5 digits
+    assert np.abs(plain.deviation / rows[:, 2] - 1).max() > 1e-3
+    a = np.select([res.alpha == -1, res.alpha == -2], [1 / (3 * np.log(2)), 0.75], 0.0)
+    np.testing.assert_allclose(res.variance, plain.variance / (1 - a * rows[:, 0] / 10_001), rtol=1e-14)
+    np.testing.assert_allclose(res.edf, plain.edf, rtol=0)
+    with pytest.raises(TypeError, match="bias_correction must be True or False"):
+        avar.totdev(y, bias_correction="yes")

@@ -39,6 +39,7 @@ from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors, 
 from avar.stability.deviation_results import Deviation
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.noise_id import NOISE_ID_ESTIMATORS, identify_noise, octave_noise, phase_noise
+from avar.stability.total_edf import totvar_bias
 
 DATA_TYPES = ("freq", "phase")
 NAN_POLICIES = ("raise", "omit")
@@ -187,8 +188,10 @@ def _noise_of_levels(estimator: str, phase: np.ndarray | OctaveMoments, drift: f
 
 
 def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, confidence: Any,
-              nan_policy: Any) -> Deviation:
-    """Validate once, compute the variances, identify the noise and bound the deviation."""
+              nan_policy: Any, bias_correction: Any = False) -> Deviation:
+    """Validate once, compute the variances, identify the noise, remove TOTVAR's bias, bound the deviation."""
+    if not isinstance(bias_correction, (bool, np.bool_)):
+        raise TypeError(f"bias_correction must be True or False, got {bias_correction!r}")
     rate = _check_options(estimator, _rate_of(data, rate), data_type, confidence, nan_policy)
     drift_removed = estimator in ("hdev", "ohdev") and data_type == "freq"  # the scan finds the drift too
     values, scanned = _check_data(data, data_type, nan_policy, weigh=drift_removed)
@@ -214,6 +217,9 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         alpha = noise_exponents(estimator, values, data_type, rate, factors)
     else:  # the variances' own detrended phase: no second pass over the data
         alpha = _noise_of_levels(estimator, phase, drift, factors)
+    if bias_correction:
+        bias = totvar_bias(alpha, factors, n_phase)
+        variance, deviation = variance / bias, deviation / np.sqrt(bias)
     edf = estimator_edf(estimator, alpha, factors, n_phase)
     if n_missing:
         edf = gap_scaled_edf(edf, n, estimator, n_phase, factors)
@@ -363,7 +369,7 @@ def ohdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
 
 
 def totdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
-           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", bias_correction: bool = True) -> Deviation:
     """Total deviation, NIST SP 1065 eq. (25)::
 
         Tot sigma_y^2(tau) = sum_{i=2}^{N-1} (x*_{i-m} - 2 x*_i + x*_{i+m})^2 / (2 tau^2 (N - 2)),
@@ -372,7 +378,6 @@ def totdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: 
     x_{1+j} and x*_{N+j} = 2 x_N - x_{N-j} (j = 1 .. N - 2); n = N - 2 terms
     at every m = 1 .. N - 1 (the range where x* is defined, as
     ``allantools.totdev``; Stable32 stops at half the record). Dimensionless.
-    No bias correction is applied (as ``allantools``).
     {parameters}
     References
     ----------
@@ -383,13 +388,23 @@ def totdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: 
     Examples
     --------
     >>> import avar
-    >>> res = avar.totdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0], taus=[1, 6])
+    >>> res = avar.totdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0], taus=[1, 6], bias_correction=False)
     >>> res.n.tolist(), res.deviation.round(6).tolist()
     ([6, 6], [1.118034, 1.096079])
+    >>> avar.totdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0], taus=[1, 6]).alpha.tolist()  # flicker FM: / (1 - a m / N)
+    [-1, -1]
     """
-    return _estimate("totdev", data, rate, data_type, taus, confidence, nan_policy)
+    return _estimate("totdev", data, rate, data_type, taus, confidence, nan_policy, bias_correction)
 
 
+_TOTDEV_BIAS = """    bias_correction : bool
+        TOTVAR is biased low against the Allan variance for flicker and
+        random-walk FM: E[TOTVAR] / AVAR = 1 - a tau / T, T = N tau0, a = 1 /
+        (3 ln 2) and 3 / 4 (Howe 1999). ``True`` (default, as Stable32)
+        divides by it at the levels identified as alpha = -1, -2; ``False``
+        gives the raw statistic, as ``allantools``.
+"""
 for _function in (adev, oadev, mdev, tdev, hdev, ohdev, totdev):
-    _function.__doc__ = _function.__doc__.replace("{parameters}", _PARAMETERS)
-del _function
+    _parameters = _PARAMETERS.replace("\n\n    Returns", "\n" + _TOTDEV_BIAS + "\n    Returns") if _function is totdev else _PARAMETERS
+    _function.__doc__ = _function.__doc__.replace("{parameters}", _parameters)
+del _function, _parameters

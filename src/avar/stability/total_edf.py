@@ -202,6 +202,25 @@ def htot_bias(alpha: np.ndarray, factors: np.ndarray) -> np.ndarray:
     return np.where(np.asarray(factors) > 1, 1.0 + a, 1.0)
 
 
+#: Howe 1999 (Table 1), NIST SP 1065 section 5.2.11: E[TOTVAR] / AVAR = 1 - a m / N for flicker
+#: and random-walk FM, a = 1 / (3 ln 2) and 3 / 4 (none for white FM and the PM noises).
+TOTVAR_BIAS = {-1: 1.0 / (3.0 * np.log(2.0)), -2: 0.75}
+
+
+def totvar_bias(alpha: np.ndarray, factors: np.ndarray, n_phase: int) -> np.ndarray:
+    """E[TOTVAR] / AVAR per level: 1 - a m / N (alpha = -1, -2), else 1; N phase points.
+
+    Stable32 divides the total variance by it: its TOTDEV tables of a flicker FM record (N = 10,001)
+    and of a clock (N = 1,253) print the raw statistic over the square root of this, to their 5 digits.
+
+    >>> totvar_bias(np.array([0, -1, -2]), np.array([100, 100, 100]), 1001).round(5).tolist()
+    [1.0, 0.95196, 0.92507]
+    """
+    alpha = np.asarray(alpha, dtype=np.int64)
+    a = np.select([alpha == key for key in TOTVAR_BIAS], list(TOTVAR_BIAS.values()), 0.0)
+    return 1.0 - a * np.asarray(factors, dtype=np.float64) / float(n_phase)
+
+
 def theo1_bias(alpha: np.ndarray, factors: np.ndarray) -> np.ndarray:
     """AVAR / Theo1 per level: a + b / r**c with r = 0.75 m (Howe and Tasset 2004, Table 1).
 
