@@ -10,7 +10,7 @@ from avar._kernels.theo import oavar_sums
 from avar._kernels.theo_fft import autocorrelation, short_autocorrelation
 from avar._kernels.theo_split import crossing_terms, groups, knot_profile, split_record
 from avar._kernels.total import theo1_sum
-from avar.stability import theo
+from avar.stability import theobr as theo
 
 NO_GAPS = np.zeros(0, dtype=np.int64)
 

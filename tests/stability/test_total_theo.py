@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from fractions import Fraction
+from pathlib import Path
 
 import allantools
 import numpy as np
@@ -186,7 +187,7 @@ def test_white_fm_theory():
 def test_theobr_factor_follows_its_definition():
     x = np.cumsum(np.random.default_rng(3).standard_normal(400))
     kf, n = theobr_factor(x)
-    assert n == 400 // 30 - 3
+    assert n == 400 // 6 - 3  # Stable32's count
     ratios = []
     for i in range(n + 1):
         ma, mt = 9 + 3 * i, 12 + 4 * i
@@ -203,8 +204,8 @@ def test_theobr_factor_follows_its_definition():
 
 def test_edf_and_bias_formulas():
     np.testing.assert_allclose(total_edf("mtotdev", np.array([2, 1, 0, -1, -2]), np.full(5, 10), 1001),
-                               [1.9 * 100.1 - 2.1, 1.2 * 100.1 - 1.4, 1.1 * 100.1 - 1.2, 0.85 * 100.1 - 0.5,
-                                0.75 * 100.1 - 0.31])
+                               [1.9 * 100.1 - 2.1, 1.734 * 100 - 2.99, 4 / 3 * 100 - 1.89, 0.85 * 100.1 - 0.5,
+                                0.75 * 100.1 - 0.31])  # Stable32's law at white FM and flicker PM, else Table 8
     r, n = 75.0, 1001.0
     assert total_edf("theo1", np.array([0]), np.array([100]), 1001)[0] == pytest.approx(
         ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * r**1.5 / (r**1.5 + 5.2))
@@ -215,7 +216,7 @@ def test_edf_and_bias_formulas():
     raw = avar.htotdev(y, taus=[4.0], alpha=-1, bias_correction=False)
     fixed = avar.htotdev(y, taus=[4.0], alpha=-1)
     assert fixed.variance[0] == pytest.approx(raw.variance[0] / 0.851)
-    t_raw = avar.theo1(y, taus=[7.5], alpha=2)
+    t_raw = avar.theo1(y, taus=[7.5], alpha=2, bias_correction=False)
     t_fix = avar.theo1(y, taus=[7.5], alpha=2, bias_correction=True)
     assert t_fix.variance[0] == pytest.approx(t_raw.variance[0] * (0.09 + 0.74 / 7.5**0.4))
     assert t_fix.alpha.tolist() == [2] and t_fix.edf[0] == pytest.approx(
@@ -248,8 +249,8 @@ def test_grids_and_validation():
         avar.htotdev(SMALL_Y, alpha=0.5)
     with pytest.raises(TypeError, match="bias_correction"):
         avar.theo1(SMALL_Y, bias_correction="yes")
-    with pytest.raises(ValueError, match="at least 90 phase points"):
-        avar.theoh(SMALL_Y)
+    with pytest.raises(ValueError, match="at least 19 phase points"):
+        avar.theoh(SMALL_Y[:10])
     with pytest.raises(ValueError, match="switch"):
         avar.theoh(np.zeros(200), switch=0.9)
     with pytest.raises(ValueError, match="data_type"):
@@ -310,26 +311,50 @@ STABLE32_MTOTDEV_LONG = [(10, 0, 5.2415e-02, 5.5529e-02, 5.9277e-02), (16, 0, 3.
                          (256, 1, 4.6190e-03, 5.9607e-03, 1.0238e-02)]
 
 
-def test_mtotdev_bounds_from_m_10_are_nists_and_wider_than_stable32s():
-    # From m = 10 Stable32's bounds imply about 4/3 (N - 1) / m - 1.89 degrees of freedom (white
-    # FM), which simulated records do not have (benchmarks/total_edf_simulation.py); Table 8's
-    # b N / m - c is kept, so the bounds are wider, by at most 2.1 % (white FM) and 5.9 % (flicker PM).
+# Stable32 1.60 of a clock's phase record of N = 1253 points (BIPM Sr87, tau0 = 2.5 s; allantoolkit's
+# tests/assets/Sr87/phase/decade/mtotdev.txt), m >= 10: AF, alpha, min, sigma, max.
+STABLE32_MTOTDEV_SR87 = [(10, 0, 6.3861e-17, 6.7260e-17, 7.1270e-17), (20, 0, 5.3546e-17, 5.7573e-17, 6.2669e-17),
+                         (40, 0, 3.9907e-17, 4.4121e-17, 5.0032e-17), (100, 1, 2.5070e-17, 2.8818e-17, 3.4977e-17)]
+
+
+@pytest.mark.parametrize("n_phase, table", [(1001, STABLE32_MTOTDEV_LONG), (1253, STABLE32_MTOTDEV_SR87)])
+def test_mtotdev_bounds_from_m_10_are_stable32s(n_phase, table):
+    # From m = 10 Stable32's bounds follow 4/3 (N - 1) / m - 1.89 degrees of freedom (white FM) and
+    # 1.734 (N - 1) / m - 2.99 (flicker PM) on records of two lengths; NIST SP 1065's Table 8 gives
+    # 10 to 45 % fewer, and simulated records fewer still (benchmarks/total_edf_simulation.py).
     from avar.stability.edf import chi2_bounds
 
-    rows = np.array(STABLE32_MTOTDEV_LONG)
+    rows = np.array(table)
     factors, alpha = rows[:, 0].astype(int), rows[:, 1].astype(int)
-    edf = total_edf("mtotdev", alpha, factors, 1001)
-    b, c = np.where(alpha == 0, 1.10, 1.20), np.where(alpha == 0, 1.20, 1.40)
-    np.testing.assert_allclose(edf, b * 1001 / factors - c, rtol=1e-15)
+    edf = total_edf("mtotdev", alpha, factors, n_phase)
     lci, uci = chi2_bounds(rows[:, 3], edf, 0.683, quantiles="stable32")
-    assert np.all(lci < rows[:, 2]) and np.all(uci > rows[:, 4])
-    wider = np.maximum(rows[:, 2] / lci, uci / rows[:, 4]) - 1
-    assert wider[alpha == 0].max() < 0.025 and wider[alpha == 1].max() < 0.06
-    # and Stable32's own law reproduces its printed bounds
-    s32 = np.where(alpha == 0, 4 / 3 * 1000 / factors - 1.89, 1.734 * 1000 / factors - 2.99)
-    lci, uci = chi2_bounds(rows[:, 3], s32, 0.683, quantiles="stable32")
     np.testing.assert_allclose(lci, rows[:, 2], rtol=6e-4)
     np.testing.assert_allclose(uci, rows[:, 4], rtol=6e-4)
+    b, c = np.where(alpha == 0, 1.10, 1.20), np.where(alpha == 0, 1.20, 1.40)
+    nist = chi2_bounds(rows[:, 3], b * n_phase / factors - c, 0.683, quantiles="stable32")
+    assert np.all(nist[0] < lci) and np.all(nist[1] > uci)  # Table 8's are wider
+
+
+def test_theo1_with_a_fixed_noise_is_scaled_by_theobr_as_stable32():
+    """Stable32's Theo1 of PHASE.DAT with alpha fixed to 1 is the raw statistic times TheoBR's kf
+    (n = floor(N / 6) - 3: 0.6028 here); with alpha = 0 it is the raw one."""
+    x = np.loadtxt(Path(__file__).parents[1] / "data" / "stable32" / "PHASE.DAT")
+    factors = np.array([10, 12, 20, 100, 400, 998])
+    fixed_flicker_pm = [8.3520e-02, 7.6196e-02, 5.6492e-02, 2.4681e-02, 1.1118e-02, 3.9001e-03]
+    white_fm = [1.0757e-01, 9.8141e-02, 7.2762e-02, 3.1789e-02, 1.4321e-02, 5.0234e-03]
+    res = avar.theo1(x, data_type="phase", taus=0.75 * factors, alpha=1)
+    np.testing.assert_allclose(res.deviation, fixed_flicker_pm, rtol=4e-5)  # Stable32 prints 5 digits
+    np.testing.assert_allclose(avar.theo1(x, data_type="phase", taus=0.75 * factors, alpha=0).deviation, white_fm,
+                               rtol=4e-5)
+    plain = avar.theo1(x, data_type="phase", taus=0.75 * factors, alpha=1, bias_correction=False)
+    kf, n = theobr_factor(x - np.polyval(np.polyfit(np.arange(x.size), x, 1), np.arange(x.size)))
+    assert n == 163 and kf == pytest.approx(0.602787, abs=2e-6)
+    np.testing.assert_allclose(res.variance, plain.variance * kf, rtol=1e-9)
+    assert avar.theo1(x, data_type="phase", taus=[7.5], alpha=1, bias_correction="theobr").deviation[0] == \
+        pytest.approx(res.deviation[0], rel=1e-12)
+    with pytest.raises(ValueError, match="gap-free"):
+        avar.theo1(np.where(np.arange(x.size) == 5, np.nan, x), data_type="phase", taus=[7.5], alpha=1,
+                   nan_policy="omit")
 
 
 def test_triangle_products_equal_their_loops():
@@ -376,7 +401,7 @@ def test_theobr_factor_of_random_walk_fm_redoes_only_the_levels_kf_needs(monkeyp
     """Random-walk FM: most expansions of kf's Theo1 sums are ill-conditioned at the per-level
     tolerance, but kf is their mean: summing directly only the worst (the smallest m) keeps
     kf within its tolerance of the all-direct mean, with far fewer direct sums."""
-    import avar.stability.theo as theo
+    import avar.stability.theobr as theo
 
     y = np.cumsum(np.random.default_rng(11).standard_normal(6000))
     x = np.concatenate([[0.0], np.cumsum(y)])

@@ -13,108 +13,21 @@ from typing import Any
 
 import numpy as np
 
-from avar._kernels.theo import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
+from avar._kernels.theo import oavar_sums
 from avar._kernels.theo_fft import autocorrelation
-from avar._kernels.theo_levels import MAX_RATIO, split_sums, theo1_sums
+from avar._kernels.theo_levels import theo1_sums
 from avar._kernels.total import theo1_sum
 from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import deviation_factors
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, noise_exponents
 from avar.stability.edf import chi2_bounds, estimator_edf
+from avar.stability.theobr import MIN_THEOBR_POINTS, theobr_count, theobr_factor, theobr_terms  # noqa: F401
 from avar.stability.total import check_alpha, prepared_phase
 from avar.stability.total_edf import total_edf, total_factors
 
-#: Fewest phase points: TheoBR's average needs n = floor(N / 30) - 3 >= 0.
-MIN_THEOH_POINTS = 90
-#: Relative error of an expanded Theo1 sum per unit of its conditioning ratio (measured:
-#: at most 6.7e-15 over the levels of random-walk FM, N = 2e4, against the direct sums).
-ERROR_PER_RATIO = 1e-14
-#: Relative error allowed in TheoBR's kf from the expanded Theo1 sums of its average (kf is
-#: an estimate whose own statistical uncertainty is of order 1e-2; ThêoH prints 5 digits).
-KF_TOLERANCE = 1e-8
-#: The split groups of kf's ill-conditioned Theo1 sums reach down to 1 / KF_REACH of their knot
-#: spacing (ratio up to about 1e4 on random-walk FM: 1e-10, far below kf's tolerance).
-KF_REACH = 16
-#: The same for kf's ill-conditioned overlapping Allan sums: reaching 1 / 16 left about 200 of
-#: random-walk FM's 33,331 (N = 1e6) above MAX_RATIO, to be summed directly (0.4 s); 1 / 8 none,
-#: for the same cost of splits.
-KF_ALLAN_REACH = 8
-
-
-def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[float, int]:
-    """TheoBR's bias factor kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(9 + 3i) / Theo1(12 + 4i),
-    n = floor(0.1 N / 3) - 3 (both at tau = (9 + 3i) tau0; AVAR overlapping), and n.
-
-    ``x``: gap-free phase, N >= 90 points; ``autocorr``: its FFT autocorrelation, if at hand.
-    The units cancel in the ratio.
-    """
-    terms, n = theobr_terms(x, autocorr)
-    return float(np.mean(terms)), n
-
-
-def theobr_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[np.ndarray, int]:
-    """The n + 1 terms AVAR(9 + 3i) / Theo1(12 + 4i) of :func:`theobr_factor`'s mean, and n.
-
-    OAVAR and Theo1 sums by FFT (:func:`avar._kernels.theo.oavar_expanded`, :func:`theo1_every`);
-    the ill-conditioned ones by the split expansion (:func:`avar._kernels.theo_levels.split_sums`:
-    OAVAR's above :data:`MAX_RATIO`, Theo1's as far as kf's tolerance needs, see
-    :func:`_levels_to_redo`), and directly if that is not enough either."""
-    n_points = x.shape[0]
-    n = int(np.floor(0.1 * n_points / 3.0)) - 3
-    i = np.arange(n + 1, dtype=np.int64)
-    m_avar = 9 + 3 * i
-    m_theo = 12 + 4 * i
-    autocorr = autocorrelation(x) if autocorr is None else autocorr
-    diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), int(m_avar[-1]) + 1)
-    avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
-    redo = np.flatnonzero(avar_ratio > MAX_RATIO)  # by the split expansion, then directly
-    if redo.size:
-        _take_better(avar_sums, avar_ratio, redo, *split_sums(x, np.zeros(0), KF_ALLAN_REACH, m_avar[redo])[2:])
-        redo = redo[avar_ratio[redo] > MAX_RATIO]
-        avar_sums[redo] = oavar_sums(x, m_avar[redo])
-    avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
-    every, ratio = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
-    theo_norm = 0.75 * (n_points - m_theo) * m_theo * m_theo
-    sums, ratio = every[m_theo], ratio[m_theo]
-    split = _levels_to_redo(avar * theo_norm / sums, ratio)  # first by the split expansion
-    if split.size:
-        _take_better(sums, ratio, split, *split_sums(x, m_theo[split], KF_REACH)[:2])
-    theo = sums / theo_norm
-    no_gaps = np.zeros(0, dtype=np.int64)
-    for level in _levels_to_redo(avar / theo, ratio):
-        theo[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0] / theo_norm[level]
-    return avar / theo, n
-
-
-def _take_better(sums: np.ndarray, ratio: np.ndarray, levels: np.ndarray, new: np.ndarray,
-                 new_ratio: np.ndarray) -> None:
-    """Replace ``sums`` and ``ratio`` at ``levels`` by ``new`` where its ratio is lower."""
-    better = new_ratio < ratio[levels]
-    sums[levels[better]] = new[better]
-    ratio[levels[better]] = new_ratio[better]
-
-
-def _levels_to_redo(terms: np.ndarray, ratio: np.ndarray) -> np.ndarray:
-    """The Theo1 levels of kf's average to sum directly: the worst-conditioned first, until
-    the error the others can bring to the mean of ``terms`` is below :data:`KF_TOLERANCE`.
-
-    A level's expanded sum errs by about ERROR_PER_RATIO x its ratio (relative), which
-    reaches its term of the mean; kf averages thousands of levels, so it needs far fewer
-    direct sums than a per-level tolerance would (random-walk FM, N = 1e5: about 50 of 3332
-    levels, the smallest m, instead of 1368). A non-finite term or ratio is always redone.
-    """
-    error = np.abs(terms) * ERROR_PER_RATIO * ratio
-    error[~np.isfinite(error)] = np.inf
-    order = np.argsort(-error, kind="stable")
-    remaining = np.cumsum(error[order][::-1])[::-1]  # error of the levels from this one on
-    finite = np.abs(terms[np.isfinite(terms)])
-    # the mean's scale from the median term, which a few ill-conditioned terms cannot inflate
-    budget = KF_TOLERANCE * terms.size * (float(np.median(finite)) if finite.size else 0.0)
-    count = int(np.count_nonzero(~(remaining <= budget)))
-    return np.sort(order[:count])
-
-
+#: Fewest phase points: those of TheoBR's average.
+MIN_THEOH_POINTS = MIN_THEOBR_POINTS
 def _levels(n_phase: int, rate: float, taus: Any, k: float) -> tuple[np.ndarray, np.ndarray]:
     """OADEV's factors below ``k`` samples and Theo1's (even m) at 0.75 m >= ``k``."""
     if isinstance(taus, str):
@@ -141,17 +54,19 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
 
         ThêoH^2(tau) = sigma_y^2(tau)  (overlapping AVAR, tau = m tau0 < k)
                      = kf Theo1(m)     (tau = 0.75 m tau0 >= k, m even <= N - 1)
-        kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i),  n = floor(N / 30) - 3,
+        kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i),  n = floor(N / 6) - 3,
 
     N phase points. kf removes Theo1's bias against the Allan variance for any
     noise mix without identifying it (TheoBR, Howe and Tasset 2004; Taylor
-    and Howe 2010 compute it decimated; this one is exact to 1e-8). The levels come
+    and Howe 2010 compute it decimated; this one is exact to 1e-8). n is
+    Stable32's (:func:`theobr_count`; Howe, Taylor and Tasset's fast TheoBR
+    stops at floor(N / 30) - 3). The levels come
     from the tau grid of each part: OADEV's factors m (``taus`` as
     :func:`avar.oadev`) below k, Theo1's even m (``taus`` as
     :func:`avar.theo1`, tau = 0.75 m tau0) from k. Each level's noise is
     identified by the OADEV rules (at 0.75 m for Theo1 levels) or fixed by
-    ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. kf needs Theo1 at every m = 2 .. N / 7.5
-    and OAVAR at N / 30 factors, all at once from FFT autocorrelations in O(N log N)
+    ``alpha``; EDF: Greenhall's OADEV EDF, then Theo1's. kf needs Theo1 at every m = 2 .. 2N / 3
+    and OAVAR at N / 6 factors, all at once from FFT autocorrelations in O(N log N)
     (:func:`avar._kernels.theo.theo1_every`). Where that expansion is ill-conditioned
     (wandering phase: random-walk FM) the sums come from the same expansion of the record
     less a broken line (:mod:`avar._kernels.theo_split`, O(N log N) per group of factors):
@@ -202,7 +117,7 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
                          "gap-free data (fill or cut them, or use theo1/oadev with nan_policy='omit')")
     if n_phase < MIN_THEOH_POINTS:
         raise ValueError(f"data has {values.size} sample(s); theoh needs at least {MIN_THEOH_POINTS} phase points "
-                         f"(TheoBR averages AVAR/Theo1 over floor(N / 30) - 2 taus)")
+                         f"(TheoBR averages AVAR/Theo1 over floor(N / 6) - 2 taus)")
     autocorr = autocorrelation(x)  # shared by kf and the displayed Theo1 levels
     kf, _ = theobr_factor(x, autocorr)
     k = float(switch) * n_phase  # in samples

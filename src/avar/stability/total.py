@@ -24,6 +24,7 @@ from avar.stability.deviation_core import phase_parts
 from avar.stability.deviation_grids import levels_with_terms
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options, noise_exponents
+from avar.stability.theobr import MIN_THEOBR_POINTS, theobr_factor
 from avar.stability.total_edf import (
     MTOT_EDF,
     htot_bias,
@@ -37,8 +38,9 @@ from avar.stability.total_edf import (
 #: MTOTVAR / MVAR per noise type (Howe and Vernotte 1999; Riley, "CI2"), applied on request only.
 MTOT_BIAS = {2: 0.94, 1: 0.83, 0: 0.73, -1: 0.70, -2: 0.69}
 _KIND = {"mtotdev": 0, "ttotdev": 0, "htotdev": 1, "theo1": 2}
-#: The deviation whose noise identification rules each statistic follows.
-_NOISE_RULES = {"mtotdev": "mdev", "ttotdev": "tdev", "htotdev": "ohdev", "theo1": "oadev"}
+#: The deviation whose noise identification rules each statistic follows: TOTDEV's for the three totals,
+#: as Stable32 (its tables of two records: the MDEV and OHDEV rules miss its alpha where few terms remain).
+_NOISE_RULES = {"mtotdev": "totdev", "ttotdev": "totdev", "htotdev": "totdev", "theo1": "oadev"}
 _MIN_PHASE = {"mtotdev": 3, "ttotdev": 3, "htotdev": 4, "theo1": 3}
 
 _PARAMETERS = """
@@ -80,9 +82,12 @@ def check_alpha(alpha: Any) -> int | None:
     return int(alpha)
 
 
-def _check_bias(bias_correction: Any) -> bool:
+def _check_bias(bias_correction: Any, estimator: str) -> bool | str | None:
+    if estimator == "theo1" and (bias_correction is None or bias_correction == "theobr"):
+        return bias_correction
     if not isinstance(bias_correction, (bool, np.bool_)):
-        raise TypeError(f"bias_correction must be True or False, got {bias_correction!r}")
+        choices = "None, 'theobr', True or False" if estimator == "theo1" else "True or False"
+        raise TypeError(f"bias_correction must be {choices}, got {bias_correction!r}")
     return bool(bias_correction)
 
 
@@ -141,7 +146,9 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
              alpha: Any, bias_correction: Any) -> Deviation:
     """Validate, compute the variances, identify the noise, correct the bias, bound the deviation."""
     alpha = check_alpha(alpha)
-    bias = _check_bias(bias_correction)
+    bias = _check_bias(bias_correction, estimator)
+    if bias is None:  # Theo1 as Stable32: TheoBR's factor once the noise is fixed to other than white FM
+        bias = "theobr" if alpha not in (None, 0) else False
     values, rate, x, bad, shift, scale, n_phase = prepared_phase(estimator, data, rate, data_type, confidence,
                                                                  nan_policy)
     factors = total_factors(estimator, n_phase, rate, taus)
@@ -156,7 +163,13 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
         alphas = noise_exponents(_NOISE_RULES[estimator], values, data_type, rate, noise_factors)
     else:
         alphas = np.full(factors.size, alpha, dtype=np.int64)
-    if bias:
+    if bias == "theobr":
+        if bad.size or n_phase < MIN_THEOBR_POINTS:
+            raise ValueError(f"theo1's TheoBR bias factor needs gap-free data of at least {MIN_THEOBR_POINTS} phase "
+                             f"points (got {n_phase}{' with NaN' if bad.size else ''}); pass bias_correction=False "
+                             "for the raw statistic or True for the fixed noise's correction")
+        variance = variance * theobr_factor(x)[0]
+    elif bias:
         variance = correct_bias(estimator, variance, alphas, factors)
     tau = (0.75 * factors if estimator == "theo1" else factors) / rate
     if estimator == "ttotdev":
@@ -275,19 +288,23 @@ def htotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
 
 def theo1(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
-          bias_correction: bool = False) -> Deviation:
+          bias_correction: bool | str | None = None) -> Deviation:
     """Theo1 deviation, NIST SP 1065 eq. (30), at tau = 0.75 m tau0 with m even::
 
         Theo1(m) = 1 / (0.75 (N - m) (m tau0)^2) sum_{i=0}^{N-m-1} sum_{d=0}^{m/2-1}
                    [(x_i - x_{i-d+m/2}) + (x_{i+m} - x_{i+d+m/2})]^2 / (m/2 - d),
 
     m = 2, 4, ... <= N - 1, n = (N - m) m / 2 terms (Stable32's ``Thêo1 #``). Dimensionless. Unbiased
-    against the Allan variance for white FM only: ``bias_correction=True``
-    multiplies by AVAR / Theo1 = a + b / r^c, r = 0.75 m (Howe and Tasset 2004;
-    white PM 0.09, 0.74, 0.40; flicker PM 0.14, 0.82, 0.30; white FM 1; flicker
-    FM 1.87, -1.05, 0.79; random-walk FM 2.70, -1.53, 0.85); the default is
-    the raw statistic, as NIST SP 1065 and ``allantools`` (which reports it at
-    tau = m tau0). :func:`avar.theoh` removes the bias from the data instead.
+    against the Allan variance for white FM only. ``bias_correction``: None
+    (default, as Stable32) gives the raw statistic, as NIST SP 1065 and
+    ``allantools`` (which reports it at tau = m tau0), unless ``alpha`` fixes
+    the noise to other than white FM, where it multiplies every level by
+    TheoBR's factor kf of the data (:func:`avar.stability.theobr.theobr_factor`;
+    Stable32's tables of two records, alpha = 1 and -1, print exactly this);
+    ``"theobr"`` always does; ``True`` multiplies by the fixed noise's AVAR /
+    Theo1 = a + b / r^c, r = 0.75 m (Howe and Tasset 2004; white PM 0.09, 0.74,
+    0.40; flicker PM 0.14, 0.82, 0.30; white FM 1; flicker FM 1.87, -1.05, 0.79;
+    random-walk FM 2.70, -1.53, 0.85); ``False`` never corrects.
     The noise is identified at the factor 0.75 m by the OADEV rules; EDF:
     Howe and Tasset (see :func:`avar.stability.total_edf.total_edf`). Each
     level costs O(N m / 2) directly; long levels of gap-free data are expanded into the

@@ -39,6 +39,10 @@ TOTAL_LONG_NAMES = {
 
 #: NIST SP 1065 Table 8: MTOTVAR (and TTOTVAR) EDF = b N / m - c.
 MTOT_EDF = {2: (1.90, 2.10), 1: (1.20, 1.40), 0: (1.10, 1.20), -1: (0.85, 0.50), -2: (0.75, 0.31)}
+#: Stable32's MTOTVAR EDF from m = 10 where it differs from Table 8: b (N - 1) / m - c for white FM
+#: and flicker PM (no published source; inverted from its printed bounds of two records, N = 1001
+#: and 1253, where it reproduces all of them to 6e-4).
+STABLE32_MTOT_EDF = {0: (4.0 / 3.0, 1.89), 1: (1.734, 2.99)}
 #: Below this factor MTOTDEV's (and TTOTDEV's) EDF is the modified Allan variance's, as
 #: Stable32's bounds show (PHASE.DAT: MDEV's EDF at m = 1 .. 8, a b N / m - c law from m = 10).
 MTOT_EDF_FROM = 10
@@ -123,13 +127,15 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
     """EDF of a total or Theo statistic at every level, floored at 1.
 
     * MTOTDEV, TTOTDEV: the modified Allan variance's (Greenhall) below m = 10,
-      as Stable32; from m = 10 b N / m - c (NIST SP 1065, Table 8). Stable32's
-      bounds there imply another law (PHASE.DAT: 4/3 (N - 1) / m - 1.89 for white
-      FM, 1.734 (N - 1) / m - 2.99 for flicker PM, none published), 20 to 50 %
-      more degrees of freedom than simulated records show, where Table 8 is
-      within 5 % (m <= 64) to 20 % (``benchmarks/total_edf_simulation.py``): the
-      bounds here are up to 2 % (white FM) and 6 % (flicker PM) wider than
-      Stable32's.
+      as Stable32; from m = 10 Stable32's 4/3 (N - 1) / m - 1.89 (white FM) and
+      1.734 (N - 1) / m - 2.99 (flicker PM), b N / m - c (NIST SP 1065, Table 8)
+      for the other noises. Stable32's law is published nowhere; it reproduces
+      its printed bounds of two records of different length (N = 1001 and 1253)
+      to 6e-4. Simulated records have 20 to 50 % fewer degrees of freedom
+      (``benchmarks/total_edf_simulation.py``: white FM, N = 1001, m = 16:
+      64 against Stable32's 81.5 and Table 8's 67.6), so these bounds, as
+      Stable32's, are narrower than the data warrant there by up to about 10 %;
+      ``MTOT_EDF`` holds Table 8's coefficients for all five noises.
     * HTOTDEV: the overlapping Hadamard variance's (Greenhall) below m = 16
       and for white and flicker PM; from m = 16 (Stable32)
       (N / m) / (b0 + b1 m / N) with (b0, b1) = (0.559, 1.004), (0.868,
@@ -149,7 +155,7 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
     Examples
     --------
     >>> total_edf("mtotdev", np.array([0, -2]), np.array([10, 10]), 1001).round(3).tolist()
-    [108.91, 74.765]
+    [131.443, 74.765]
     >>> total_edf("theo1", np.array([0]), np.array([100]), 1001).round(3).tolist()
     [51.215]
     """
@@ -161,8 +167,12 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
         at = alpha == a
         mm = m[at]
         if estimator in ("mtotdev", "ttotdev"):
-            b, c = MTOT_EDF[int(a)]
-            value = b * n / mm - c
+            if int(a) in STABLE32_MTOT_EDF:
+                b, c = STABLE32_MTOT_EDF[int(a)]
+                value = b * (n - 1.0) / mm - c
+            else:
+                b, c = MTOT_EDF[int(a)]
+                value = b * n / mm - c
             small = mm < MTOT_EDF_FROM
             if small.any():
                 value[small] = estimator_edf("mdev", np.full(int(small.sum()), a), mm[small].astype(np.int64),
