@@ -423,3 +423,17 @@ def test_theobr_factor_of_random_walk_fm_redoes_only_the_levels_kf_needs(monkeyp
     assert kf_default == pytest.approx(direct, rel=1e-8)
     assert kf == pytest.approx(direct, rel=1e-11)
     assert 0 < len(calls) < n + 1 and 12 + 4 * n not in calls  # the worst conditioned: small factors
+
+
+def test_theo1_every_on_threads_gives_the_serial_bits(monkeypatch):
+    import avar._kernels.theo as kernels
+
+    x = np.cumsum(np.random.default_rng(21).standard_normal(3000))
+    x -= x.mean()
+    autocorr = autocorrelation(x)
+    diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), 1001)
+    threaded = theo1_every(x, 2000, autocorr, diagonals)
+    monkeypatch.setattr(kernels, "run_concurrently", lambda *calls: [call() for call in calls])
+    serial = theo1_every(x, 2000, autocorr, lag_diagonals(x, np.ascontiguousarray(x[::-1]), 1001))
+    assert all(np.array_equal(a, b) for a, b in zip(threaded, serial))
+    assert all(np.array_equal(a, b) for a, b in zip(diagonals, lag_diagonals(x, np.ascontiguousarray(x[::-1]), 1001)))

@@ -22,7 +22,7 @@ import queue
 import threading
 from collections.abc import Callable
 
-__all__ = ["run_ranges", "run_tasks", "threads"]
+__all__ = ["run_concurrently", "run_ranges", "run_tasks", "threads"]
 
 #: Jobs for the helper threads: each takes tasks of one :func:`run_tasks` call until none is left.
 _JOBS: queue.SimpleQueue = queue.SimpleQueue()
@@ -135,3 +135,36 @@ def run_ranges(n_items: int, work: Callable[[int, int], object]) -> None:
     parts = max(1, min(n_items, PARTS_PER_THREAD * threads()))
     bounds = [n_items * p // parts for p in range(parts + 1)]
     run_tasks(parts, lambda p: work(bounds[p], bounds[p + 1]))
+
+
+def run_concurrently(*calls: Callable[[], object]) -> list:
+    """Call each of ``calls`` once, at the same time on up to :func:`threads` threads; their results in order.
+
+    For a few unequal, independent pieces of work (FFT products, ``nogil`` kernels) rather than
+    many like ones. The first runs in the calling thread, which then takes the others still
+    waiting; each result is computed as it would be alone, so the bits do not depend on the
+    number of threads. Calls may nest: a calling thread never waits for work it could do.
+
+    >>> run_concurrently(lambda: 1 + 1, lambda: "b", lambda: None)
+    [2, 'b', None]
+    """
+    results: list = [None] * len(calls)
+
+    def task(i: int) -> None:
+        results[i] = calls[i]()
+
+    helpers = min(threads(), len(calls)) - 1
+    if helpers <= 0:
+        for i in range(len(calls)):
+            task(i)
+        return results
+    call = _Call(len(calls), task)
+    _ensure_helpers(helpers)
+    for _ in range(helpers):
+        _JOBS.put(call.work)
+    try:
+        task(0)
+    finally:
+        call.work()
+        call.wait()
+    return results

@@ -22,10 +22,13 @@ gap-free, detrended x.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numba import njit
 from scipy import fft
 
+from avar._kernels.tasks import run_concurrently
 from avar._kernels.theo_fft import half_convolution, hankel_lower, phi_sums
 
 #: Step (in log t) of the exponential sum: its relative error is below 5e-16 at 0.25.
@@ -45,7 +48,7 @@ def exp_sum(largest: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(([0.0], t)), np.concatenate(([below], _STEP * t))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _running_sums(x, reverse, autocorr, rest, diag, diag_reverse, count, t, w):
     """For m = 0 .. count - 1: sum_{a<=m/2} F(m-a)/a, the same of ``rest``, sum_{q<m} z_q
     sum_{a<=q/2} z_{q-a}/a, the lag >= h pairs / (m - l), and at even m the even-lag
@@ -123,8 +126,8 @@ def _running_sums(x, reverse, autocorr, rest, diag, diag_reverse, count, t, w):
 
 
 def lag_diagonals(x: np.ndarray, reverse: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """D(a) = sum_{j<a} x_j x_{j+a} of x and of its reverse, a = 0 .. count - 1 (FFT)."""
-    return hankel_lower(x, x, count), hankel_lower(reverse, reverse, count)
+    """D(a) = sum_{j<a} x_j x_{j+a} of x and of its reverse, a = 0 .. count - 1 (FFT; the two at once)."""
+    return tuple(run_concurrently(lambda: hankel_lower(x, x, count), lambda: hankel_lower(reverse, reverse, count)))
 
 
 def theo1_every(x: np.ndarray, largest: int, autocorr: np.ndarray, diagonals: tuple) -> tuple[np.ndarray, np.ndarray]:
@@ -146,7 +149,12 @@ def theo1_every(x: np.ndarray, largest: int, autocorr: np.ndarray, diagonals: tu
     lags = np.ascontiguousarray(autocorr[:count])
     t, w = exp_sum(max(largest, 2))
     diag, diag_reverse = (np.ascontiguousarray(d[: h[-1] + 1]) for d in diagonals)
-    hc_lags, hc_rest, pairs, long, corners = _running_sums(x, reverse, lags, rest, diag, diag_reverse, count, t, w)
+    def corner_of(z: np.ndarray) -> Callable[[], np.ndarray]:
+        return lambda: half_convolution(phi_sums(z, h[-1] + 1), z, count)
+
+    # the running sums and the two ends' corner products at the same time
+    (hc_lags, hc_rest, pairs, long, corners), corner_x, corner_reverse = run_concurrently(
+        lambda: _running_sums(x, reverse, lags, rest, diag, diag_reverse, count, t, w), corner_of(x), corner_of(reverse))
     upsampled = np.zeros(count)  # sum_{a<=h} F(m - 2a) / a: a convolution
     upsampled[2::2] = inverse[1 : (count + 1) // 2]
     size = fft.next_fast_len(2 * count, real=True)
@@ -154,16 +162,14 @@ def theo1_every(x: np.ndarray, largest: int, autocorr: np.ndarray, diagonals: tu
     square = weight * (squares[n_points - k] + squares[n_points] - squares[k]) + np.cumsum(inverse * rest)[h] + hc_rest
     cross = weight * lags + double - 2.0 * np.cumsum(inverse * lags)[h] - 2.0 * hc_lags
     pairs = pairs + np.cumsum(inverse[: h[-1] + 1] * (diag + diag_reverse))[h]
-    corners = corners[2 * h]
-    for z in (x, reverse):
-        corners = corners + half_convolution(phi_sums(z, h[-1] + 1), z, count)
+    corners = corners[2 * h] + corner_x + corner_reverse
     total = square + 2.0 * cross + 2.0 * (pairs + long) - 2.0 * corners
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(total > 0, np.maximum(square, weight * squares[-1]) / total, np.inf)
     return total, ratio
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def oavar_sums(x: np.ndarray, factors: np.ndarray) -> np.ndarray:
     """sum_{i=0}^{N-2m-1} (x_{i+2m} - 2 x_{i+m} + x_i)**2 at every factor m."""
     out = np.zeros(factors.shape[0])

@@ -80,7 +80,7 @@ def _padded(values: np.ndarray, length: int) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _hankel_leaves(y: np.ndarray, kappa: np.ndarray, out: np.ndarray, leaf: int) -> None:
     for start in range(0, out.shape[0], leaf):
         for g in range(start + 1, start + leaf):
@@ -113,7 +113,7 @@ def hankel_lower(y: np.ndarray, kappa: np.ndarray, count: int) -> np.ndarray:
     return out[:count]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _half_leaves(f: np.ndarray, g: np.ndarray, out: np.ndarray, leaf: int) -> None:
     for start in range(0, f.shape[0], leaf):
         for a in range(start, start + leaf):

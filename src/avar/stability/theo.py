@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from avar._kernels.tasks import run_concurrently
 from avar._kernels.theo import oavar_sums
 from avar._kernels.theo_fft import autocorrelation
 from avar._kernels.theo_levels import theo1_sums
@@ -119,13 +120,15 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
         raise ValueError(f"data has {values.size} sample(s); theoh needs at least {MIN_THEOH_POINTS} phase points "
                          f"(TheoBR averages AVAR/Theo1 over floor(N / 6) - 2 taus)")
     autocorr = autocorrelation(x)  # shared by kf and the displayed Theo1 levels
-    kf, _ = theobr_factor(x, autocorr)
     k = float(switch) * n_phase  # in samples
     allan, theo = _levels(n_phase, rate, taus, k)
     unit = rate * rate if data_type == "phase" else 1.0
-    avar = oavar_sums(x, allan) / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit
     no_gaps = np.zeros(0, dtype=np.int64)
-    sums = theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0)[0], autocorr)[0]
+    (kf, _), sums, allan_sums = run_concurrently(  # kf and the displayed levels at the same time
+        lambda: theobr_factor(x, autocorr),
+        lambda: theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0)[0], autocorr)[0],
+        lambda: oavar_sums(x, allan))
+    avar = allan_sums / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit
     counts = n_phase - theo
     theobr = kf * sums / (0.75 * counts * theo * theo) / scale / scale * unit
     factors = np.concatenate((allan, theo))
