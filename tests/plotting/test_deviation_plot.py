@@ -37,3 +37,13 @@ def test_tdev_label_and_options():
         plot_deviation(res, colour="notacolour")
     with pytest.raises(TypeError, match="error_bars"):
         plot_deviation(res, error_bars=1)
+
+
+def test_theoh_draws_its_allan_and_theo1_levels_as_two_lines():
+    x = np.cumsum(np.random.default_rng(4).standard_normal(1253))
+    res = avar.theoh(x, data_type="phase")  # OADEV to m = 256 (tau 256 s), Theo1 from tau 192 s
+    fig = res.plot(error_bars=False)
+    lines = [line for line in fig.axes[0].lines if len(line.get_xdata())]
+    assert [len(line.get_xdata()) for line in lines] == [9, 3]
+    np.testing.assert_array_equal(lines[1].get_xdata(), res.taus[9:])
+    assert lines[0].get_label().endswith(f"N = {res.n_samples}") and lines[1].get_label().startswith("_")  # one legend entry

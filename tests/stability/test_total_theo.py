@@ -437,3 +437,22 @@ def test_theo1_every_on_threads_gives_the_serial_bits(monkeypatch):
     serial = theo1_every(x, 2000, autocorr, lag_diagonals(x, np.ascontiguousarray(x[::-1]), 1001))
     assert all(np.array_equal(a, b) for a, b in zip(threaded, serial))
     assert all(np.array_equal(a, b) for a, b in zip(diagonals, lag_diagonals(x, np.ascontiguousarray(x[::-1]), 1001)))
+
+
+def test_theoh_levels_are_stable32s_table():
+    """Stable32's ThêoH of a 1253-point record (octave): OADEV at m = 1 .. 256 (<= N / 4), Theo1 at
+    m = 256, 512, 1024 (>= floor(N / 5)), both at m = 256; decade: OADEV to 200, Theo1 at 400, 1000."""
+    x = np.cumsum(np.random.default_rng(4).standard_normal(1253))
+    octave = avar.theoh(x, data_type="phase")
+    assert octave.averaging_factors.tolist() == [1, 2, 4, 8, 16, 32, 64, 128, 256, 256, 512, 1024]
+    assert octave.taus.tolist()[8:] == [256.0, 192.0, 384.0, 768.0]  # Allan tau m tau0, Theo1's 0.75 m tau0
+    oadev = avar.oadev(x, data_type="phase", taus=octave.taus[:9])
+    np.testing.assert_allclose(octave.deviation[:9], oadev.deviation, rtol=1e-12)
+    theo1 = avar.theo1(x, data_type="phase", taus=octave.taus[9:], bias_correction="theobr")
+    np.testing.assert_allclose(octave.deviation[9:], theo1.deviation, rtol=1e-9)
+    decade = avar.theoh(x, data_type="phase", taus="decade")
+    assert decade.averaging_factors.tolist() == [1, 2, 4, 10, 20, 40, 100, 200, 400, 1000]
+    explicit = avar.theoh(x, data_type="phase", taus=[300.0, 301.5, 750.0])  # m = 300 <= 313: OADEV
+    assert explicit.averaging_factors.tolist() == [300, 402, 1000]
+    howe = avar.theoh(x, data_type="phase", switch=0.1)
+    assert howe.taus.max() == octave.taus.max() and 128 not in howe.averaging_factors[:8].tolist()

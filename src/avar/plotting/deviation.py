@@ -85,7 +85,10 @@ def plot_deviation(
     fig, ax = new_axes(ax)
     setup_log_axes(ax)
     label = f"{x.name}, N = {x.n_samples}"
-    ax.plot(x.taus, x.deviation, color=colour, marker=marker, linewidth=1.3, label=label, zorder=3)
+    # one line per run of increasing taus (ThêoH: its Allan levels, then its Theo1 levels, which may overlap)
+    for i, part in enumerate(np.split(np.arange(x.taus.size), np.flatnonzero(np.diff(x.taus) < 0) + 1)):
+        ax.plot(x.taus[part], x.deviation[part], color=colour, marker=marker, linewidth=1.3,
+                label=label if i == 0 else None, zorder=3)
     drawn = [x.deviation]
     if error_bars:
         valid = np.isfinite(x.lci) & np.isfinite(x.uci) & (x.lci > 0)

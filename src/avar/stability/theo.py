@@ -29,11 +29,19 @@ from avar.stability.total_edf import total_edf, total_factors
 
 #: Fewest phase points: those of TheoBR's average.
 MIN_THEOH_POINTS = MIN_THEOBR_POINTS
-def _levels(n_phase: int, rate: float, taus: Any, k: float) -> tuple[np.ndarray, np.ndarray]:
-    """OADEV's factors below ``k`` samples and Theo1's (even m) at 0.75 m >= ``k``."""
+#: Stable32's ThêoH table: OADEV at its own factors (m <= N / 4) and Theo1 from m = floor(N / THEO_FROM).
+THEO_FROM = 5
+
+
+def _levels(n_phase: int, rate: float, taus: Any, k: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """OADEV's factors below ``k`` samples and Theo1's (even m) at 0.75 m >= ``k``; with ``k`` None
+    Stable32's table: OADEV at its factors up to N / 4, Theo1 at its even m from floor(N / 5) (the
+    two overlap between N / 5 and N / 4)."""
     if isinstance(taus, str):
         allan = deviation_factors("oadev", n_phase, rate, taus)
         theo = total_factors("theo1", n_phase, rate, taus)
+        if k is None:
+            return allan[allan <= n_phase // 4], theo[theo >= n_phase // THEO_FROM]
         return allan[allan < k], theo[0.75 * theo >= k]
     try:
         requested = np.atleast_1d(np.asarray(taus, dtype=np.float64))
@@ -42,7 +50,11 @@ def _levels(n_phase: int, rate: float, taus: Any, k: float) -> tuple[np.ndarray,
     if requested.ndim != 1 or requested.size == 0:
         raise TypeError(f"taus must be 'octave', 'decade', 'all' or a non-empty 1-D array of averaging times (s), "
                         f"got {taus!r}")
-    short = requested * rate < k
+    m = requested * rate
+    if k is None:  # an OADEV factor where the tau is one (a whole m up to N / 4), else Theo1's
+        short = (np.abs(m - np.round(m)) <= 1e-9 * np.maximum(m, 1.0)) & (np.round(m) <= n_phase // 4)
+    else:
+        short = m < k
     allan = deviation_factors("oadev", n_phase, rate, requested[short]) if short.any() else np.zeros(0, np.int64)
     theo = total_factors("theo1", n_phase, rate, requested[~short]) if (~short).any() else np.zeros(0, np.int64)
     return allan, theo
@@ -50,11 +62,11 @@ def _levels(n_phase: int, rate: float, taus: Any, k: float) -> tuple[np.ndarray,
 
 def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
-          switch: float = 0.1) -> Deviation:
-    """ThêoH deviation: OADEV for tau < k, TheoBR for tau >= k, k = ``switch`` x N tau0::
+          switch: float | None = None) -> Deviation:
+    """ThêoH deviation: OADEV at short taus, TheoBR at long ones::
 
-        ThêoH^2(tau) = sigma_y^2(tau)  (overlapping AVAR, tau = m tau0 < k)
-                     = kf Theo1(m)     (tau = 0.75 m tau0 >= k, m even <= N - 1)
+        ThêoH^2(tau) = sigma_y^2(tau)  (overlapping AVAR, tau = m tau0)
+                     = kf Theo1(m)     (tau = 0.75 m tau0, m even <= N - 1)
         kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i),  n = floor(N / 6) - 3,
 
     N phase points. kf removes Theo1's bias against the Allan variance for any
@@ -82,9 +94,14 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
         As :func:`avar.theo1`.
     nan_policy : {"raise", "omit"}
         ThêoH needs gap-free data: NaN raises ``ValueError`` either way.
-    switch : float
-        k as a fraction of the record N tau0, in (0, 0.5]; 0.1 (the range of
-        Allan taus that TheoBR's kf averages over).
+    switch : float or None
+        None (default): the levels of Stable32's ThêoH table, OADEV at its own
+        factors (m <= N / 4 on the grids) and Theo1 at its even m from
+        floor(N / 5): the two overlap between N / 5 and N / 4, where both are
+        given (Allan levels first, then Theo1's; Stable32's tables of a
+        1253-point record show exactly these rows). A fraction of the record
+        in (0, 0.5] gives Howe's hybrid instead: OADEV for tau < k, TheoBR for
+        tau >= k, k = ``switch`` x N tau0 (Howe uses 0.1).
 
     Returns
     -------
@@ -102,15 +119,18 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
     --------
     >>> import numpy as np, avar
     >>> y = np.random.default_rng(0).standard_normal(1000)  # white FM
-    >>> res = avar.theoh(y)
+    >>> res = avar.theoh(y)  # OADEV to m = N / 4, Theo1 from m = N / 5 (N = 1001)
     >>> res.taus.tolist()
-    [1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 192.0, 384.0]
+    [1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 192.0, 384.0]
     >>> res.n.tolist()[6:]  # N - 2m (OADEV), then (N - m) m / 2 (Theo1)
-    [873, 95360, 125184]
+    [873, 745, 95360, 125184]
+    >>> avar.theoh(y, switch=0.1).taus.tolist()  # Howe's hybrid: OADEV below 0.1 N tau0
+    [1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 192.0, 384.0]
     """
     alpha = check_alpha(alpha)
-    if isinstance(switch, (bool, np.bool_)) or not isinstance(switch, numbers.Real) or not 0.0 < switch <= 0.5:
-        raise ValueError(f"switch must be a fraction of the record in (0, 0.5], e.g. 0.1, got {switch!r}")
+    if switch is not None and (isinstance(switch, (bool, np.bool_)) or not isinstance(switch, numbers.Real)
+                               or not 0.0 < switch <= 0.5):
+        raise ValueError(f"switch must be None or a fraction of the record in (0, 0.5], e.g. 0.1, got {switch!r}")
     values, rate, x, bad, _, scale, n_phase = prepared_phase("theoh", data, rate, data_type, confidence, nan_policy)
     if bad.size:
         missing = np.flatnonzero(np.isnan(values))
@@ -120,7 +140,7 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
         raise ValueError(f"data has {values.size} sample(s); theoh needs at least {MIN_THEOH_POINTS} phase points "
                          f"(TheoBR averages AVAR/Theo1 over floor(N / 6) - 2 taus)")
     autocorr = autocorrelation(x)  # shared by kf and the displayed Theo1 levels
-    k = float(switch) * n_phase  # in samples
+    k = None if switch is None else float(switch) * n_phase  # in samples
     allan, theo = _levels(n_phase, rate, taus, k)
     unit = rate * rate if data_type == "phase" else 1.0
     no_gaps = np.zeros(0, dtype=np.int64)
