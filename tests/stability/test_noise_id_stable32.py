@@ -114,7 +114,8 @@ def test_b1_rule_thresholds():
 
 def test_noise_rules_are_the_lag1_dmax():
     assert {name: int(rule) for name, rule in NOISE_ID_ESTIMATORS.items()} == {
-        "adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3}
+        "adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3,
+        "mtotdev": 2, "ttotdev": 2, "htotdev": 2}
     assert all(rule.estimator == name for name, rule in NOISE_ID_ESTIMATORS.items())
 
 
@@ -147,3 +148,16 @@ def test_levels_past_b1_hold_the_previous_alpha():
     oadev_boundary = np.sqrt(b1_theory(851, -1) * b1_theory(851, -2))
     assert oadev_boundary < 0.831 < adev_boundary
     assert identify_noise(x, [75], "adev")[0] == 1 and identify_noise(x, [75], "oadev")[0] == 0
+
+
+def test_totals_read_b1_with_their_own_term_count_down_to_6_averages():
+    """Stable32's HTOTDEV of PHASE.DAT (octave) prints flicker PM at m = 128 and 256, where
+    OHDEV's rule said white FM; on a 1253-point clock record its MTOTDEV, TTOTDEV and HTOTDEV
+    columns (143 all-tau rows each) follow B1 with n = the statistic's own "#" while K >= 6."""
+    from avar.stability.noise_id import b1_rule
+
+    res = avar.htotdev(_phase_dat(), data_type="phase", taus="octave")
+    assert res.alpha.tolist() == [0] * 7 + [1, 1]
+    assert b1_rule("mtotdev", 1253, 201, 6) == (True, 1253 - 3 * 201 + 1)
+    assert b1_rule("htotdev", 1253, 201, 6) == (True, 1253 - 3 * 201)
+    assert b1_rule("ttotdev", 1253, 209, 5)[0] is False and b1_rule("totdev", 1253, 209, 5)[0] is True

@@ -18,6 +18,7 @@ import numpy as np
 
 from avar._validation import short_repr
 from avar.stability.deviation_grids import term_counts
+from avar.stability.total_edf import term_counts as total_term_counts
 
 #: The lag-1 autocorrelation is used where at least this many frequency averages K = (N - 1) // m remain
 #: (Stable32 switches to B1 at K = 29: its MDEV table of an OCXO's 19,982 readings, m = 659 -> 672).
@@ -25,9 +26,12 @@ MIN_ACF_POINTS = 30
 #: The B1 ratio needs at least this many averages (with 2, B1 = 1 for every noise).
 MIN_B1_POINTS = 3
 #: Stable32 reads B1 only where at least this many frequency averages K remain (ADEV and
-#: HDEV 10, TOTDEV 4, the others 8); at a level with fewer, alpha is the previous level's
-#: (its tables of PHASE.DAT and of a 10,000-point flicker FM record).
-MIN_B1_AVERAGES = {"adev": 10, "hdev": 10, "totdev": 4}
+#: HDEV 10, TOTDEV 4, MTOTDEV, TTOTDEV and HTOTDEV 6, the others 8); at a level with fewer,
+#: alpha is the previous level's (its tables of PHASE.DAT, of a 10,000-point flicker FM
+#: record and of a 1253-point clock record).
+MIN_B1_AVERAGES = {"adev": 10, "hdev": 10, "totdev": 4, "mtotdev": 6, "ttotdev": 6, "htotdev": 6}
+#: The total statistics, identified by TOTDEV's lag-1 rule (dmax = 2) and B1 with their own term count.
+TOTALS = ("mtotdev", "ttotdev", "htotdev")
 DEFAULT_B1_AVERAGES = 8
 
 
@@ -45,7 +49,8 @@ class NoiseRule(int):
 
 #: Estimator -> its :class:`NoiseRule` (the lag-1 method's dmax, and the estimator).
 NOISE_ID_ESTIMATORS = {name: NoiseRule(dmax, name) for name, dmax in
-                       {"adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3}.items()}
+                       {"adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3,
+                        **dict.fromkeys(TOTALS, 2)}.items()}
 
 
 def b1_rule(estimator: str | None, n: int, m: int, k: int) -> tuple[bool, int]:
@@ -60,7 +65,8 @@ def b1_rule(estimator: str | None, n: int, m: int, k: int) -> tuple[bool, int]:
     """
     if estimator is None:
         return k >= MIN_B1_POINTS, k
-    terms = int(term_counts(estimator, n, np.array([m], dtype=np.int64))[0])
+    counts = total_term_counts if estimator in TOTALS else term_counts
+    terms = int(counts(estimator, n, np.array([m], dtype=np.int64))[0])
     enough = k >= MIN_B1_AVERAGES.get(estimator, DEFAULT_B1_AVERAGES)
     return enough and k >= MIN_B1_POINTS, terms
 #: Offsets per cluster at which R(n)'s modified Allan variance is sampled (O(N / m) per level).
@@ -100,7 +106,9 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
        1 / m (white PM) and that of flicker PM splits alpha = 2 from 1 (NIST
        SP 1065 section 5.6; MVAR is sampled at 64 offsets per cluster).
     4. Stable32 reads B1 only while K >= 10 averages remain for ADEV and
-       HDEV, K >= 4 for TOTDEV and K >= 8 for the other estimators; beyond
+       HDEV, K >= 4 for TOTDEV, K >= 6 for MTOTDEV, TTOTDEV and HTOTDEV
+       (which otherwise follow TOTDEV's rules, dmax = 2) and K >= 8 for the
+       other estimators; beyond
        (or for a constant series) alpha is that of the nearest smaller m
        identified (or larger; 0 if none is). These rules reproduce the noise
        column of 2,415 of the 2,416 rows of Stable32's all-tau tables of ADEV,
@@ -117,7 +125,7 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
         as x = (0, cumsum(y)) tau0.
     factors : array_like of int
         Averaging factors m, 1 <= m < N.
-    estimator : {"adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev"}
+    estimator : {"adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev"}
         The deviation whose levels these are (it sets dmax, B1's sample
         size and where B1 stops).
 

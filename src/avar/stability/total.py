@@ -38,9 +38,10 @@ from avar.stability.total_edf import (
 #: MTOTVAR / MVAR per noise type (Howe and Vernotte 1999; Riley, "CI2"), applied on request only.
 MTOT_BIAS = {2: 0.94, 1: 0.83, 0: 0.73, -1: 0.70, -2: 0.69}
 _KIND = {"mtotdev": 0, "ttotdev": 0, "htotdev": 1, "theo1": 2}
-#: The deviation whose noise identification rules each statistic follows: TOTDEV's for the three totals,
-#: as Stable32 (its tables of two records: the MDEV and OHDEV rules miss its alpha where few terms remain).
-_NOISE_RULES = {"mtotdev": "totdev", "ttotdev": "totdev", "htotdev": "totdev", "theo1": "oadev"}
+#: The noise identification rules each statistic follows: the totals' own (TOTDEV's lag-1 rule, B1 with
+#: their term counts from 6 averages), as Stable32 (its tables of two records: the MDEV and OHDEV rules
+#: miss its alpha where few terms remain); Theo1 OADEV's at 0.75 m.
+_NOISE_RULES = {"mtotdev": "mtotdev", "ttotdev": "ttotdev", "htotdev": "htotdev", "theo1": "oadev"}
 _MIN_PHASE = {"mtotdev": 3, "ttotdev": 3, "htotdev": 4, "theo1": 3}
 
 _PARAMETERS = """
