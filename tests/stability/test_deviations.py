@@ -288,7 +288,7 @@ def test_totdev_removes_totvars_bias_as_stable32():
     np.testing.assert_allclose(res.deviation, rows[:, 2], rtol=3e-5)  # Stable32 prints 5 digits
     assert np.abs(plain.deviation / rows[:, 2] - 1).max() > 1e-3
     a = np.select([res.alpha == -1, res.alpha == -2], [1 / (3 * np.log(2)), 0.75], 0.0)
-    np.testing.assert_allclose(res.variance, plain.variance / (1 - a * rows[:, 0] / 10_001), rtol=1e-14)
+    np.testing.assert_allclose(res.variance, plain.variance / (1 - a * rows[:, 0] / 10_000), rtol=1e-14)  # N given
     np.testing.assert_allclose(res.edf, plain.edf, rtol=0)
     with pytest.raises(TypeError, match="bias_correction must be True or False"):
         avar.totdev(y, bias_correction="yes")

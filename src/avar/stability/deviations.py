@@ -218,7 +218,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     else:  # the variances' own detrended phase: no second pass over the data
         alpha = _noise_of_levels(estimator, phase, drift, factors)
     if bias_correction:
-        bias = totvar_bias(alpha, factors, n_phase)
+        bias = totvar_bias(alpha, factors, values.size)  # T = the record's count of points, as Stable32
         variance, deviation = variance / bias, deviation / np.sqrt(bias)
     edf = estimator_edf(estimator, alpha, factors, n_phase)
     if n_missing:
@@ -399,7 +399,8 @@ def totdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: 
 
 _TOTDEV_BIAS = """    bias_correction : bool
         TOTVAR is biased low against the Allan variance for flicker and
-        random-walk FM: E[TOTVAR] / AVAR = 1 - a tau / T, T = N tau0, a = 1 /
+        random-walk FM: E[TOTVAR] / AVAR = 1 - a tau / T, T = N tau0 (N the
+        number of phase or frequency points given, as Stable32), a = 1 /
         (3 ln 2) and 3 / 4 (Howe 1999). ``True`` (default, as Stable32)
         divides by it at the levels identified as alpha = -1, -2; ``False``
         gives the raw statistic, as ``allantools``.

@@ -217,18 +217,20 @@ def htot_bias(alpha: np.ndarray, factors: np.ndarray) -> np.ndarray:
 TOTVAR_BIAS = {-1: 1.0 / (3.0 * np.log(2.0)), -2: 0.75}
 
 
-def totvar_bias(alpha: np.ndarray, factors: np.ndarray, n_phase: int) -> np.ndarray:
-    """E[TOTVAR] / AVAR per level: 1 - a m / N (alpha = -1, -2), else 1; N phase points.
+def totvar_bias(alpha: np.ndarray, factors: np.ndarray, n_points: int) -> np.ndarray:
+    """E[TOTVAR] / AVAR per level: 1 - a m / N (alpha = -1, -2), else 1.
 
-    Stable32 divides the total variance by it: its TOTDEV tables of a flicker FM record (N = 10,001)
-    and of a clock (N = 1,253) print the raw statistic over the square root of this, to their 5 digits.
+    Stable32 divides the total variance by it, with N the number of data points given (phase
+    or frequency): its TOTDEV tables of a flicker FM record (10,000 frequency points) and of a
+    clock (1253 phase points, and the same record as 1252 frequency points) print the raw
+    statistic over the square root of this, to their 5 digits.
 
     >>> totvar_bias(np.array([0, -1, -2]), np.array([100, 100, 100]), 1001).round(5).tolist()
     [1.0, 0.95196, 0.92507]
     """
     alpha = np.asarray(alpha, dtype=np.int64)
     a = np.select([alpha == key for key in TOTVAR_BIAS], list(TOTVAR_BIAS.values()), 0.0)
-    return 1.0 - a * np.asarray(factors, dtype=np.float64) / float(n_phase)
+    return 1.0 - a * np.asarray(factors, dtype=np.float64) / float(n_points)
 
 
 def theo1_bias(alpha: np.ndarray, factors: np.ndarray) -> np.ndarray:
