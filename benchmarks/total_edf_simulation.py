@@ -8,8 +8,7 @@ level and prints it next to:
 * ``avar``: what avar uses (:func:`avar.stability.total_edf.total_edf`: for MTOTVAR
   from m = 10 Stable32's law at white FM and flicker PM, NIST SP 1065 Table 8 at the
   other noises, the modified Allan variance's Greenhall EDF below m = 10; HTOTVAR's
-  (N / m) / (b0 + b1 m / N) from m = 16, the overlapping Hadamard variance's Greenhall
-  EDF below);
+  (N / m) / (b0 + b1 m / N) from m = 16, NIST SP 1065 Table 5's simple EDF below and at PM);
 * ``nist``: NIST SP 1065 Table 8 for MTOTVAR from m = 10 (b N / m - c);
 * ``stable32``: the EDF that Stable32 1.60's printed bounds imply, where its tables
   of PHASE.DAT show it (alpha = 0 and 1; from its bounds with its own chi-squared

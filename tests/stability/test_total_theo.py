@@ -210,8 +210,7 @@ def test_edf_and_bias_formulas():
     assert total_edf("theo1", np.array([0]), np.array([100]), 1001)[0] == pytest.approx(
         ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * r**1.5 / (r**1.5 + 5.2))
     assert total_edf("htotdev", np.array([-1]), np.array([32]), 1001)[0] == pytest.approx((n / 32) / (0.868 + 1.14 * 32 / n))
-    assert total_edf("htotdev", np.array([-1]), np.array([8]), 1001)[0] == pytest.approx(
-        estimator_edf("ohdev", [-1], [8], 1001)[0])
+    assert total_edf("htotdev", np.array([-1]), np.array([8]), 1001)[0] == pytest.approx(5 * 1001**2 / (32 * 1025))
     y = np.random.default_rng(5).standard_normal(500)
     raw = avar.htotdev(y, taus=[4.0], alpha=-1, bias_correction=False)
     fixed = avar.htotdev(y, taus=[4.0], alpha=-1)
@@ -261,8 +260,10 @@ def test_grids_and_validation():
 
 
 # Stable32 on its PHASE.DAT (N = 1001 phase points), confidence 0.683: AF, #, alpha, min, sigma, max.
-STABLE32_HTOTDEV = [(16, 953, 0, 6.1280e-02, 6.5265e-02, 7.0151e-02), (32, 905, 0, 4.0870e-02, 4.4644e-02, 4.9703e-02),
-                    (64, 809, 0, 2.9694e-02, 3.3576e-02, 3.9530e-02)]
+STABLE32_HTOTDEV = [(1, 998, 0, 2.8670e-01, 2.9439e-01, 3.0274e-01), (2, 995, 0, 1.9726e-01, 2.0297e-01, 2.0922e-01),
+                    (4, 989, 0, 1.3744e-01, 1.4252e-01, 1.4821e-01), (8, 977, 0, 1.0303e-01, 1.0822e-01, 1.1430e-01),
+                    (16, 953, 0, 6.1280e-02, 6.5265e-02, 7.0151e-02), (32, 905, 0, 4.0870e-02, 4.4644e-02, 4.9703e-02),
+                    (64, 809, 0, 2.9694e-02, 3.3576e-02, 3.9530e-02), (128, 617, 1, 2.6309e-02, 2.8790e-02, 3.2137e-02)]
 STABLE32_COUNTS = {"mtotdev": {1: 999, 2: 996, 16: 954, 256: 234}, "htotdev": {1: 998, 2: 995, 128: 617, 256: 233},
                    "theo1": {10: 4955, 100: 45050, 998: 1497}}  # Thêo1 #, printed 4.9550e+03 ...
 
@@ -274,8 +275,10 @@ def test_stable32_htotdev_bounds_and_term_counts():
     rows = np.array(STABLE32_HTOTDEV)
     edf = total_edf("htotdev", rows[:, 2].astype(int), rows[:, 0].astype(int), 1001)
     lci, uci = chi2_bounds(rows[:, 4], edf, 0.683, quantiles="stable32")
-    np.testing.assert_allclose(lci, rows[:, 3], rtol=1.2e-4)  # Stable32 prints 5 digits (exact quantiles: 4.6e-4)
-    np.testing.assert_allclose(uci, rows[:, 5], rtol=1.2e-4)
+    # m >= 16: Stable32 prints 5 digits (exact quantiles: 4.6e-4); below, NIST SP 1065 Table 5's EDF,
+    # which Stable32's bounds follow to 4e-4 (Greenhall's overlapping Hadamard EDF: 7e-3); flicker PM 3e-3
+    tolerance = np.where(rows[:, 2] == 1, 3e-3, np.where(rows[:, 0] >= 16, 1.2e-4, 4e-4))
+    assert np.all(np.abs(lci / rows[:, 3] - 1) < tolerance) and np.all(np.abs(uci / rows[:, 5] - 1) < tolerance)
     for name, counts in STABLE32_COUNTS.items():
         assert term_counts(name, 1001, np.array(list(counts))).tolist() == list(counts.values())
     # Stable32's HTOTDEV of PHASE.DAT with and without its bias removal at m = 2 (alpha = 0):

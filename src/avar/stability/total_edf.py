@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from avar._validation import short_repr
-from avar.stability.edf import estimator_edf
+from avar.stability.edf import estimator_edf, simple_edf
 from avar.stability.grids import grid_factors
 
 TOTAL_ESTIMATORS = ("mtotdev", "ttotdev", "htotdev", "theo1", "theoh")
@@ -48,8 +48,8 @@ STABLE32_MTOT_EDF = {0: (4.0 / 3.0, 1.89), 1: (1.734, 2.99)}
 MTOT_EDF_FROM = 10
 #: NIST SP 1065 (Howe et al. 2000): HTOTVAR EDF = (N / m) / (b0 + b1 m / N), for m >= 16.
 HTOT_EDF = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696)}
-#: Below this factor HTOTDEV's EDF is the overlapping Hadamard variance's (Stable32 switches
-#: here; its printed bounds below m = 16 are narrower than both Greenhall EDFs).
+#: Below this factor HTOTDEV's EDF is NIST SP 1065 Table 5's simple approximation (Stable32 switches
+#: here; its printed bounds below m = 16 follow Table 5, not the Greenhall EDFs).
 HTOT_EDF_FROM = 16
 #: Howe et al. 2000: E[HTOTVAR] / HVAR = 1 + a (m > 1); Stable32 divides by it.
 HTOT_BIAS = {0: -0.005, -1: -0.149, -2: -0.229}
@@ -136,15 +136,16 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
       64 against Stable32's 81.5 and Table 8's 67.6), so these bounds, as
       Stable32's, are narrower than the data warrant there by up to about 10 %;
       ``MTOT_EDF`` holds Table 8's coefficients for all five noises.
-    * HTOTDEV: the overlapping Hadamard variance's (Greenhall) below m = 16
-      and for white and flicker PM; from m = 16 (Stable32)
-      (N / m) / (b0 + b1 m / N) with (b0, b1) = (0.559, 1.004), (0.868,
-      1.140), (0.938, 1.696) for alpha = 0, -1, -2. Stable32's EDF is higher
-      below m = 16 (PHASE.DAT, white FM: 669, 572, 349, 184 at m = 1 .. 8 against
-      609, 452, 257, 140; no published formula gives them) and for flicker PM;
-      simulated records have more still (597, 385, 208 at m = 2, 4, 8), so the
-      bounds here are conservative: up to 1 % wider than Stable32's at white FM,
-      3 % at flicker PM.
+    * HTOTDEV: from m = 16 (Stable32) (N / m) / (b0 + b1 m / N) with (b0, b1)
+      = (0.559, 1.004), (0.868, 1.140), (0.938, 1.696) for alpha = 0, -1, -2
+      (NIST SP 1065); below m = 16 and at white and flicker PM the simple
+      approximations of NIST SP 1065 Table 5
+      (:func:`avar.stability.edf.simple_edf`), which Stable32's bounds follow:
+      its EDFs on two records (N = 1001, 1253; white, flicker and random-walk
+      FM, m = 1 .. 10) are 0.4 to 1.3 % above them, where the overlapping
+      Hadamard variance's Greenhall EDF is 10 to 36 % lower. Simulated records
+      have more than either (597, 385, 208 at m = 2, 4, 8, white FM,
+      N = 1001; Table 5: 570, 346, 182).
     * Theo1 (Howe and Tasset 2004; NIST SP 1065, Table 11), r = 0.75 m:
       alpha = 2: 0.86 (N + 1)(N - 4r/3) / (N - r) * r / (r + 1.14);
       1: (4.798 N**2 - 6.374 N r + 12.387 r) / (sqrt(r + 36.6) (N - r)) * r / (r + 0.3);
@@ -179,7 +180,7 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
                                              int(n_phase))
             edf[at] = value
         elif estimator == "htotdev":
-            value = estimator_edf("ohdev", np.full(mm.shape, a), mm.astype(np.int64), int(n_phase))
+            value = simple_edf(n, mm, np.full(mm.shape, a))
             if int(a) in HTOT_EDF:
                 b0, b1 = HTOT_EDF[int(a)]
                 value = np.where(mm >= HTOT_EDF_FROM, (n / mm) / (b0 + b1 * mm / n), value)
