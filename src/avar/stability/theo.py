@@ -23,7 +23,7 @@ from avar.stability.deviation_grids import deviation_factors
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import DEFAULT_CONFIDENCE, noise_exponents
 from avar.stability.edf import chi2_bounds, estimator_edf
-from avar.stability.theobr import MIN_THEOBR_POINTS, theobr_count, theobr_factor, theobr_terms  # noqa: F401
+from avar.stability.theobr import MIN_THEOBR_POINTS, theobr_factor
 from avar.stability.total import check_alpha, prepared_phase
 from avar.stability.total_edf import total_edf, total_factors
 

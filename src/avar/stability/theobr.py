@@ -25,9 +25,9 @@ KF_TOLERANCE = 1e-8
 #: The split groups of kf's ill-conditioned Theo1 sums reach down to 1 / KF_REACH of their knot
 #: spacing (ratio up to about 1e4 on random-walk FM: 1e-10, far below kf's tolerance).
 KF_REACH = 16
-#: The same for kf's ill-conditioned overlapping Allan sums: reaching 1 / 16 left about 200 of
-#: random-walk FM's 33,331 (N = 1e6) above MAX_RATIO, to be summed directly (0.4 s); 1 / 8 none,
-#: for the same cost of splits.
+#: The same for kf's ill-conditioned overlapping Allan sums (with N / 30 of them, reaching 1 / 16
+#: left about 200 of random-walk FM's 33,331 at N = 1e6 to be summed directly; 1 / 8 none, for the
+#: same cost of splits).
 KF_ALLAN_REACH = 8
 
 
@@ -35,7 +35,7 @@ def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[fl
     """TheoBR's bias factor kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(9 + 3i) / Theo1(12 + 4i),
     n = floor(N / 6) - 3 (both at tau = (9 + 3i) tau0; AVAR overlapping), and n (:func:`theobr_count`).
 
-    ``x``: gap-free phase, N >= 90 points; ``autocorr``: its FFT autocorrelation, if at hand.
+    ``x``: gap-free phase, N >= 19 points; ``autocorr``: its FFT autocorrelation, if at hand.
     The units cancel in the ratio.
     """
     terms, n = theobr_terms(x, autocorr)
@@ -48,8 +48,9 @@ def theobr_count(n_points: int) -> int:
     factor would leave no Allan term, and the average stops one short.
 
     Howe, Taylor and Tasset's fast TheoBR averages to n = floor(0.1 N / 3) - 3 instead; on
-    Stable32's tables of two records (N = 1001 and 1253) only floor(N / 6) - 3 reproduces the
-    printed values (to their 5 digits; the other count differs by 1 to 4 %).
+    Stable32's tables of two records only floor(N / 6) - 3 reproduces the printed values (to
+    their 5 digits: kf = 0.602787 at N = 1001, 1.349115 at N = 1253; the other count gives
+    1.0857 and 1.3171).
 
     >>> theobr_count(1001), theobr_count(1253), theobr_count(1002)
     (163, 205, 163)
@@ -62,9 +63,9 @@ def theobr_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[np.
     """The n + 1 terms AVAR(9 + 3i) / Theo1(12 + 4i) of :func:`theobr_factor`'s mean, and n.
 
     OAVAR and Theo1 sums by FFT (:func:`avar._kernels.theo.oavar_expanded`, :func:`theo1_every`);
-    the ill-conditioned ones by the split expansion (:func:`avar._kernels.theo_levels.split_sums`:
-    OAVAR's above :data:`MAX_RATIO`, Theo1's as far as kf's tolerance needs, see
-    :func:`_levels_to_redo`), and directly if that is not enough either."""
+    the ill-conditioned ones by the split expansion (:func:`avar._kernels.theo_levels.split_sums`),
+    each kind as far as half of kf's tolerance needs (see :func:`_levels_to_redo`), and directly
+    if that is not enough either."""
     n_points = x.shape[0]
     n = theobr_count(n_points)
     i = np.arange(n + 1, dtype=np.int64)

@@ -84,7 +84,8 @@ def check_alpha(alpha: Any) -> int | None:
 
 
 def _check_bias(bias_correction: Any, estimator: str) -> bool | str | None:
-    if estimator == "theo1" and (bias_correction is None or bias_correction == "theobr"):
+    if estimator == "theo1" and (bias_correction is None or (isinstance(bias_correction, str)
+                                                             and bias_correction == "theobr")):
         return bias_correction
     if not isinstance(bias_correction, (bool, np.bool_)):
         choices = "None, 'theobr', True or False" if estimator == "theo1" else "True or False"
@@ -205,10 +206,15 @@ def mtotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     adjacent m-point phase averages of x*(n): the 3m-point window x_n ..
     x_{n+3m-1} less the line through the means of its halves, extended at both
     ends by uninverted even reflection to 9m points. tau = m tau0, m = 1 .. N / 3,
-    n = N - 3m + 1 terms. Dimensionless. EDF: the modified Allan variance's (Greenhall)
-    below m = 10, as Stable32, then b N / m - c (NIST SP 1065 Table 8).
+    n = N - 3m + 1 terms. Dimensionless. The noise is identified by TOTDEV's
+    lag-1 rule and, where few averages remain, B1 with n terms (as Stable32).
+    EDF: the modified Allan variance's (Greenhall) below m = 10, as Stable32,
+    then Stable32's b (N - 1) / m - c at white FM and flicker PM and NIST SP 1065
+    Table 8's b N / m - c at the other noises (see
+    :func:`avar.stability.total_edf.total_edf`).
     ``bias_correction=True`` divides by MTOTVAR / MVAR (0.94, 0.83, 0.73, 0.70,
-    0.69 for alpha = 2 .. -2); Stable32 and ``allantools`` do not (default False).
+    0.69 for alpha = 2 .. -2), as Stable32 when its bias removal is on; its
+    default and ``allantools`` do not (default False).
     Each level costs O(N) (the blocked expansion of :mod:`avar._kernels.total_blocks`
     over the runs of windows that avoid the gaps, exact up to rounding; small
     levels take the direct O(N m) loop, cheaper there).
@@ -265,10 +271,11 @@ def htotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     Insensitive to a linear frequency drift. Dimensionless.
     ``bias_correction=True`` (default, Stable32) divides by E[Htot var] / Hvar
     = 1 + a for m > 1, a = -0.005, -0.149, -0.229 for alpha = 0, -1, -2 (none
-    for PM noise); ``allantools`` applies none. EDF: the Hadamard variance's
-    below m = 16, then (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`),
-    which equals Stable32's printed bounds from m = 16. Each level costs O(N),
-    as :func:`mtotdev`.
+    for PM noise); ``allantools`` applies none. Noise identified as for
+    :func:`mtotdev`. EDF: NIST SP 1065 Table 5's below m = 16 and at PM, then
+    (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`),
+    as Stable32's printed bounds (to 4e-4 below m = 16, to 1.2e-4 from there).
+    Each level costs O(N), as :func:`mtotdev`.
     {parameters}
     References
     ----------
