@@ -176,7 +176,7 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
     tau = (0.75 * factors if estimator == "theo1" else factors) / rate
     if estimator == "ttotdev":
         variance = variance * tau * tau / 3.0
-    edf = total_edf(estimator, alphas, factors, n_phase)
+    edf = total_edf(estimator, alphas, factors, n_phase, n_given=values.size)
     if bad.size:
         edf = np.maximum(edf * n / term_counts(estimator, n_phase, factors), 1.0)
     deviation = np.sqrt(variance)

@@ -123,15 +123,20 @@ def total_factors(estimator: str, n_phase: int, rate: float, taus: Any) -> np.nd
     return exact
 
 
-def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: int) -> np.ndarray:
+def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: int,
+              n_given: int | None = None) -> np.ndarray:
     """EDF of a total or Theo statistic at every level, floored at 1.
+
+    ``n_given``: the number of data points given (frequency data: N - 1), which
+    Stable32's MTOTVAR law takes for its N; default ``n_phase``.
 
     * MTOTDEV, TTOTDEV: the modified Allan variance's (Greenhall) below m = 10,
       as Stable32; from m = 10 Stable32's 4/3 (N - 1) / m - 1.89 (white FM) and
       1.734 (N - 1) / m - 2.99 (flicker PM), b N / m - c (NIST SP 1065, Table 8)
       for the other noises. Stable32's law is published nowhere; it reproduces
       its printed bounds of two records of different length (N = 1001 and 1253)
-      to 6e-4. Simulated records have 20 to 50 % fewer degrees of freedom
+      to 6e-4, with N the number of points given (its frequency and phase tables
+      of one record differ so). Simulated records have 20 to 50 % fewer degrees of freedom
       (``benchmarks/total_edf_simulation.py``: white FM, N = 1001, m = 16:
       64 against Stable32's 81.5 and Table 8's 67.6), so these bounds, as
       Stable32's, are narrower than the data warrant there by up to about 10 %;
@@ -170,7 +175,7 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
         if estimator in ("mtotdev", "ttotdev"):
             if int(a) in STABLE32_MTOT_EDF:
                 b, c = STABLE32_MTOT_EDF[int(a)]
-                value = b * (n - 1.0) / mm - c
+                value = b * (float(n_phase if n_given is None else n_given) - 1.0) / mm - c
             else:
                 b, c = MTOT_EDF[int(a)]
                 value = b * n / mm - c
