@@ -143,7 +143,9 @@ def run_concurrently(*calls: Callable[[], object]) -> list:
     For a few unequal, independent pieces of work (FFT products, ``nogil`` kernels) rather than
     many like ones. The first runs in the calling thread, which then takes the others still
     waiting; each result is computed as it would be alone, so the bits do not depend on the
-    number of threads. Calls may nest: a calling thread never waits for work it could do.
+    number of threads. Calls may nest: a calling thread never waits for work it could do. The
+    first exception a call raises is raised here once no call is running; the calls not
+    started by then are not started.
 
     >>> run_concurrently(lambda: 1 + 1, lambda: "b", lambda: None)
     [2, 'b', None]
