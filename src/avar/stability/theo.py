@@ -27,8 +27,6 @@ from avar.stability.theobr import MIN_THEOBR_POINTS, theobr_factor
 from avar.stability.total import check_alpha, prepared_phase
 from avar.stability.total_edf import total_edf, total_factors
 
-#: Fewest phase points: those of TheoBR's average.
-MIN_THEOH_POINTS = MIN_THEOBR_POINTS
 #: Stable32's ThêoH table: OADEV at its own factors (m <= N / 4) and Theo1 from m = floor(N / THEO_FROM).
 THEO_FROM = 5
 
@@ -136,8 +134,8 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
         missing = np.flatnonzero(np.isnan(values))
         raise ValueError(f"data has {missing.size} NaN value(s), the first at index {missing[0]}; theoh needs "
                          "gap-free data (fill or cut them, or use theo1/oadev with nan_policy='omit')")
-    if n_phase < MIN_THEOH_POINTS:
-        raise ValueError(f"data has {values.size} sample(s); theoh needs at least {MIN_THEOH_POINTS} phase points "
+    if n_phase < MIN_THEOBR_POINTS:
+        raise ValueError(f"data has {values.size} sample(s); theoh needs at least {MIN_THEOBR_POINTS} phase points "
                          f"(TheoBR averages AVAR/Theo1 over floor(N / 6) - 2 taus)")
     autocorr = autocorrelation(x)  # shared by kf and the displayed Theo1 levels
     k = None if switch is None else float(switch) * n_phase  # in samples

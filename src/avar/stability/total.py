@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from avar._kernels.theo_fft import autocorrelation
 from avar._kernels.theo_levels import theo1_sums
 from avar._kernels.total import level_sums, theo1_sum
 from avar.stability.chi2 import CATALOGUE_QUANTILES, chi2_bounds
@@ -108,10 +109,12 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
 
 
 def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int,
-                  scale: float, rate: float, is_phase: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Unbiased-as-defined variances and term counts (NaN where no term is left)."""
+                  scale: float, rate: float, is_phase: bool,
+                  autocorr: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Unbiased-as-defined variances and term counts (NaN where no term is left); ``autocorr``:
+    the FFT autocorrelation of gap-free ``x`` for Theo1, if at hand."""
     if estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
-        sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift)[0])[0]
+        sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift)[0], autocorr)[0]
         counts = x.shape[0] - factors
     else:  # HTOTDEV's m = 1 is OHDEV (below): its level is not summed
         first = int(estimator == "htotdev" and factors.size > 0 and factors[0] == 1)
@@ -157,7 +160,9 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
     if factors.size == 0:
         raise ValueError(f"data has too few points for any {estimator} level (largest factor "
                          f"{largest_factor(estimator, n_phase)})")
-    variance, n = raw_variances(estimator, x, factors, bad, shift, scale, rate, data_type == "phase")
+    # Theo1 scaled by kf: one FFT autocorrelation of the record serves both
+    autocorr = autocorrelation(x) if bias == "theobr" and bad.size == 0 else None
+    variance, n = raw_variances(estimator, x, factors, bad, shift, scale, rate, data_type == "phase", autocorr)
     n, variance, factors = levels_with_terms(estimator, n, (variance, factors),
                                              "the NaN values of data" if bad.size else None)
     if alpha is None:
@@ -170,7 +175,7 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
             raise ValueError(f"theo1's TheoBR bias factor needs gap-free data of at least {MIN_THEOBR_POINTS} phase "
                              f"points (got {n_phase}{' with NaN' if bad.size else ''}); pass bias_correction=False "
                              "for the raw statistic or True for the fixed noise's correction")
-        variance = variance * theobr_factor(x)[0]
+        variance = variance * theobr_factor(x, autocorr)[0]
     elif bias:
         variance = correct_bias(estimator, variance, alphas, factors)
     tau = (0.75 * factors if estimator == "theo1" else factors) / rate
