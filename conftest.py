@@ -4,6 +4,10 @@ Plots render headless. Nothing here reaches outside the repository: the data set
 inside the package. A bare ``pytest`` in an environment without the package's
 dependencies stops at once with the command that installs them, instead of
 one import error per test module.
+
+The suite runs on up to four processes (pytest-xdist; ``addopts`` in pyproject.toml):
+the numba kernels compile once per process, so a cold run takes half the time on two
+cores. ``pytest -n 0`` runs it in one process.
 """
 
 import importlib.util
@@ -20,7 +24,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent / "tests"))
 
 #: What ``pip install ".[test]"`` brings that every test module needs (import name: package).
 REQUIRED = {"numpy": "numpy", "scipy": "scipy", "pandas": "pandas", "matplotlib": "matplotlib",
-            "numba": "numba", "yaml": "pyyaml", "tqdm": "tqdm", "avar": "avar"}
+            "numba": "numba", "yaml": "pyyaml", "tqdm": "tqdm", "avar": "avar", "xdist": "pytest-xdist"}
+
+
+def pytest_addoption(parser):
+    # Without pytest-xdist, the "--numprocesses" of pyproject's addopts would stop pytest at its command
+    # line, before pytest_configure can name what is missing: accept it, then say so there.
+    if importlib.util.find_spec("xdist") is None:
+        parser.addoption("--numprocesses", dest="numprocesses", default=None)
+        parser.addoption("--maxprocesses", dest="maxprocesses", default=None)
 
 
 def pytest_configure(config):
