@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import allantools
 import numpy as np
@@ -176,3 +177,23 @@ def test_frequency_gaps_skip_the_windows_that_span_them():
                 expected = math.sqrt(np.mean([(x[i + m] - x[i]) ** 2 for i in starts]))
             assert n == len(starts)
             assert dev == pytest.approx(expected, rel=1e-9)
+
+
+#: Stable32 1.60 on its PHASE.DAT (1001 phase points, tau0 = 1 s): (AF, #, value), from the
+#: MTIE and TIE rms tables kept in allantools' tests (5 printed digits).
+STABLE32_PHASE_DAT = {
+    "mtie": [(1, 1000, 5.0597e-01), (3, 998, 1.2984e+00), (7, 994, 2.2922e+00), (15, 986, 2.9949e+00),
+             (31, 970, 4.4550e+00), (63, 938, 6.5989e+00), (127, 874, 6.8061e+00), (255, 746, 7.8205e+00),
+             (511, 490, 7.8205e+00)],
+    "tierms": [(1, 1000, 2.8832e-01), (2, 999, 4.0240e-01), (3, 998, 4.9390e-01), (10, 991, 8.7588e-01),
+               (71, 930, 2.3318e+00), (133, 868, 2.9611e+00), (247, 754, 2.6144e+00)],
+}
+
+
+@pytest.mark.parametrize("name", sorted(STABLE32_PHASE_DAT))
+def test_stable32_tables_of_phase_dat(name):
+    x = np.loadtxt(Path(__file__).resolve().parents[1] / "data" / "stable32" / "PHASE.DAT")
+    rows = np.array(STABLE32_PHASE_DAT[name])
+    res = getattr(avar, name)(x, rate=1.0, data_type="phase", taus=rows[:, 0])
+    assert res.n.tolist() == rows[:, 1].astype(int).tolist()
+    np.testing.assert_allclose(res.deviation, rows[:, 2], rtol=5e-5)  # Stable32 prints 5 digits
