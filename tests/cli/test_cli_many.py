@@ -48,7 +48,7 @@ def files(tmp_path_factory) -> list:
 @pytest.fixture(scope="module")
 def cluster():
     """A running 2-worker cluster of single-threaded processes: its scheduler address."""
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None) as running:
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0") as running:
         yield running.scheduler_address
 
 

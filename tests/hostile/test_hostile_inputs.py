@@ -210,7 +210,7 @@ def test_lost_workers_end_in_one_line():
 
     from avar.stability.dask_backend import WorkerLost, map_on_cluster
 
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0",
                                   silence_logs=50) as cluster, distributed.Client(cluster) as client:
         import dask
 

@@ -43,7 +43,7 @@ def test_local_cluster_threads_and_files(tmp_path):
         path = tmp_path / f"series{i}.npy"
         np.save(path, rng.standard_normal(20_000 + 1000 * i))
         paths.append(str(path))
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster:
         with distributed.Client(cluster) as client:
             x = np.load(paths[0])
             got = allan_variance_dask(da.from_array(x, chunks=3000), octave(x.size), "mo", min_chunk=1)

@@ -211,7 +211,9 @@ def cluster_client(scheduler: Any = None, workers: int = 2, timeout: float | Non
     from dask.distributed import Client, LocalCluster
 
     if scheduler is None:
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+        # ":0": the scheduler's HTTP server (dashboard, metrics) on a free port; None would still
+        # take 8787 and warn when another cluster (another avar run) holds it.
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
                           silence_logs=logging.CRITICAL) as cluster:
             with Client(cluster) as client:
                 yield client
