@@ -90,6 +90,18 @@ def test_adversarial_offsets_against_exact_arithmetic(estimator):
             assert v == pytest.approx(expected, rel=1e-10)
 
 
+@pytest.mark.parametrize("estimator", ESTIMATORS)
+def test_a_long_offset_stays_exact(estimator):
+    """1e9 + 1e-6 noise, 1500 values: the phase's low part (float32) accumulates what the
+    increments lose to the offset and the removed drift, which must stay below its precision
+    (the Hadamard pair removed the drift from the undetrended value: errors of 1e-8)."""
+    y = 1e9 + 1e-6 * np.random.default_rng(4).standard_normal(1500)
+    factors = np.array([1, 3, 16, 100])
+    variance, _ = deviation_levels(estimator, y, factors, "freq", 1.0)
+    for m, v in zip(factors, variance):
+        assert v == pytest.approx(exact_variance(estimator, y, int(m), "freq")[0], rel=1e-12)
+
+
 def test_results_do_not_depend_on_the_thread_count():
     y = np.random.default_rng(3).standard_normal(300_000)
     threads = numba.get_num_threads()

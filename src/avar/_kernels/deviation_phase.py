@@ -110,11 +110,16 @@ def _increment(data, data_lo, i, kind, centre, slope, scale):
     else:
         h = data[i]
         l = 0.0
+    # centre first: an increment near the mean frequency loses nothing to it (Sterbenz), and the
+    # drift then comes off a small number, whose rounding error is small too. The other order
+    # leaves the rounding error of a large increment (up to half its ulp) in the low part,
+    # which the phase accumulates in float32.
+    h, e2 = _two_sum(h, -centre)
+    l += e2
     if slope != 0.0:
         h, e1 = _two_sum(h, -(slope * i))
         l += e1
-    h, e2 = _two_sum(h, -centre)
-    return h * scale, (l + e2) * scale
+    return h * scale, l * scale
 
 
 @njit(cache=True, nogil=True)
