@@ -19,6 +19,13 @@ import pytest
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
+# pytest.approx(x, rel=r) also accepts anything within 1e-12 of x: for the 1e-13 deviations
+# of clocks and the 1e-15 variances of good gyros that makes every comparison pass. Here it is
+# relative alone unless a test names its own abs.
+from _pytest.python_api import ApproxScalar  # noqa: E402
+
+ApproxScalar.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
+
 # Shared test helpers (tests/reference.py) import as top-level modules.
 sys.path.insert(0, str(Path(__file__).resolve().parent / "tests"))
 

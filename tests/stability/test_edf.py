@@ -147,9 +147,11 @@ def test_chi2_bounds_vectorized_and_extreme_confidence():
     lci, uci = chi2_bounds(deviation, np.array([3.0, 3.0, 3.0]))
     assert lci[0] == uci[0] == 0.0 and lci[2] == pytest.approx(2 * lci[1], rel=1e-15)
     # 1 - 1e-13: ppf(1 - q) would lose the tail; the bounds still hold their probability
-    lci, uci = chi2_bounds(1.0, 10.0, confidence=1 - 1e-13)
-    assert chi2.sf(10.0 / lci**2, 10.0) == pytest.approx(0.5e-13, rel=1e-6)
-    assert chi2.cdf(10.0 / uci**2, 10.0) == pytest.approx(0.5e-13, rel=1e-6)
+    confidence = 1 - 1e-13
+    tail = (1 - confidence) / 2  # exact (Sterbenz): 5.0016e-14, the float nearest 1 - 1e-13 is not 1 - 1e-13
+    lci, uci = chi2_bounds(1.0, 10.0, confidence=confidence)
+    assert chi2.sf(10.0 / lci**2, 10.0) == pytest.approx(tail, rel=1e-9)
+    assert chi2.cdf(10.0 / uci**2, 10.0) == pytest.approx(tail, rel=1e-9)
     assert 0 < lci < 1 < uci < np.inf
     assert np.isnan(chi2_bounds(1.0, np.nan)[0])
 
@@ -177,3 +179,29 @@ def test_chi2_bounds_vectorized_and_extreme_confidence():
 def test_validation_names_the_argument(call, error, message):
     with pytest.raises(error, match=message):
         call()
+
+
+# Stable32 on a Keysight 53230A time-interval record (N = 55,688 phase points; white and flicker PM,
+# white FM at TOTDEV's longest taus), kept in allantools' tests: (m, alpha, min sigma, sigma,
+# max sigma). The bounds need only N, m, alpha and the printed sigma; N this large takes
+# Greenhall's algorithm through its long-sum branches.
+STABLE32_LONG = {
+    "oadev": [(1, 2, 1.7629e-11, 1.7702e-11, 1.7776e-11), (64, 2, 2.7844e-13, 2.7960e-13, 2.8077e-13), (1024, 2, 1.7589e-14, 1.7663e-14, 1.7738e-14), (2048, 1, 8.5857e-15, 8.8933e-15, 9.2367e-15), (8192, 1, 2.1277e-15, 2.2694e-15, 2.4439e-15)],
+    "mdev": [(1, 2, 1.7629e-11, 1.7702e-11, 1.7776e-11), (64, 2, 3.9878e-14, 4.0708e-14, 4.1593e-14), (1024, 2, 1.3270e-15, 1.4367e-15, 1.5789e-15), (2048, 1, 8.3873e-16, 9.4879e-16, 1.1179e-15), (8192, 1, 2.7966e-16, 3.5547e-16, 5.7122e-16)],
+    "tdev": [(1, 2, 1.0178e-11, 1.0220e-11, 1.0263e-11), (64, 2, 1.4735e-12, 1.5042e-12, 1.5369e-12), (1024, 2, 7.8454e-13, 8.4936e-13, 9.3347e-13), (2048, 1, 9.9173e-13, 1.1219e-12, 1.3218e-12), (8192, 1, 1.3227e-12, 1.6812e-12, 2.7017e-12)],
+    "hdev": [(1, 2, 1.8570e-11, 1.8654e-11, 1.8739e-11), (64, 2, 2.8073e-13, 2.9072e-13, 3.0187e-13), (1024, 2, 1.5635e-14, 1.7772e-14, 2.1119e-14), (2048, 1, 8.7188e-15, 1.0348e-14, 1.3452e-14), (8192, 1, 9.4771e-16, 1.2817e-15, 2.9912e-15)],
+    "ohdev": [(1, 2, 1.8570e-11, 1.8654e-11, 1.8739e-11), (64, 2, 2.9326e-13, 2.9459e-13, 2.9593e-13), (1024, 2, 1.8542e-14, 1.8627e-14, 1.8714e-14), (2048, 1, 9.0364e-15, 9.3893e-15, 9.7873e-15), (8192, 1, 2.1814e-15, 2.3474e-15, 2.5583e-15)],
+    "totdev": [(1, 2, 1.7628e-11, 1.7702e-11, 1.7777e-11), (64, 2, 2.7862e-13, 2.7980e-13, 2.8098e-13), (1024, 2, 1.7644e-14, 1.7719e-14, 1.7795e-14), (2048, 1, 8.7523e-15, 8.9523e-15, 9.1668e-15), (8192, 0, 1.9371e-15, 2.3153e-15, 3.0614e-15), (16384, 0, 1.0189e-15, 1.2833e-15, 1.9897e-15)],
+}
+
+
+@pytest.mark.parametrize("estimator", sorted(STABLE32_LONG))
+def test_bounds_of_a_long_record_match_stable32(estimator):
+    rows = np.array(STABLE32_LONG[estimator])
+    factors, alpha = rows[:, 0].astype(int), rows[:, 1].astype(int)
+    edf = estimator_edf(estimator, alpha, factors, 55688)
+    lci, uci = chi2_bounds(rows[:, 3], edf, 0.683, quantiles="stable32")
+    # 5 printed digits on intervals down to +-0.4 %: agreement to 3.4e-4 (HDEV at m = 8192, 4 terms)
+    np.testing.assert_allclose(lci, rows[:, 2], rtol=4e-4)
+    np.testing.assert_allclose(uci, rows[:, 4], rtol=4e-4)
+    assert not np.allclose(chi2_bounds(rows[:, 3], 0.9 * edf, 0.683)[1], rows[:, 4], rtol=4e-4, atol=0)
