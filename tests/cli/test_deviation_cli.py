@@ -41,6 +41,21 @@ def test_tables_print_the_library_values(capsys, phase_file):
             np.testing.assert_allclose([float(r[4]) for r in rows], expected.lci, rtol=1e-4)
 
 
+def test_a_fixed_noise_reaches_every_statistic(capsys, phase_file):
+    path, x = phase_file
+    code, out, err = cli(capsys, "deviation", path, "--stat", "totdev", "--stat", "theo1", "--data-type", "phase",
+                         "--noise", "-1")
+    assert code == 0, err
+    for block, name in zip(out.strip().split("\n\n"), ("totdev", "theo1")):
+        rows = [line.split() for line in block.splitlines()[2:]]
+        expected = getattr(avar, name)(x, rate=2.0, data_type="phase", alpha=-1)
+        assert {r[3] for r in rows} == {"-1"}
+        np.testing.assert_allclose([float(r[5]) for r in rows], expected.deviation, rtol=1e-4)
+        np.testing.assert_allclose([float(r[6]) for r in rows], expected.uci, rtol=1e-4)
+    code, _, err = cli(capsys, "deviation", path, "--data-type", "phase", "--noise", "3")
+    assert code == 2 and "--noise" in err
+
+
 def test_csv_and_figure_outputs(capsys, phase_file, tmp_path):
     path, x = phase_file
     csv, png = tmp_path / "out.csv", tmp_path / "out.png"

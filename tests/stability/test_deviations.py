@@ -199,6 +199,9 @@ def test_series_input():
         (dict(nan_policy="drop"), ValueError, "nan_policy"),
         (dict(data=pd.DataFrame({"a": range(10)})), TypeError, "DataFrame"),
         (dict(data=np.ones(10, dtype=complex)), TypeError, "complex"),
+        (dict(alpha=3), ValueError, r"alpha must be in -2 \.\. 2"),
+        (dict(alpha=0.5), TypeError, "alpha must be None or an integer"),
+        (dict(alpha=True), TypeError, "alpha must be None or an integer"),
     ],
 )
 def test_bad_inputs_name_the_argument(kwargs, error, message):
@@ -292,3 +295,34 @@ def test_totdev_removes_totvars_bias_as_stable32():
     np.testing.assert_allclose(res.edf, plain.edf, rtol=0)
     with pytest.raises(TypeError, match="bias_correction must be True or False"):
         avar.totdev(y, bias_correction="yes")
+
+
+@pytest.mark.parametrize("estimator", ESTIMATORS)
+def test_a_fixed_alpha_sets_every_levels_edf_and_bounds(estimator):
+    """alpha= as Stable32's fixed noise type: the same deviations, the EDF of that noise at every
+    level (NIST SP 1065's tables / Greenhall's algorithm), its chi-squared bounds."""
+    from avar.stability.chi2 import CATALOGUE_QUANTILES, chi2_bounds
+    from avar.stability.edf import estimator_edf
+
+    y = np.random.default_rng(5).standard_normal(2000)
+    free = getattr(avar, estimator)(y, taus="decade", bias_correction=False) if estimator == "totdev" \
+        else getattr(avar, estimator)(y, taus="decade")
+    for alpha in (2, 0, -1) if estimator in ("hdev", "ohdev") else (2, 1, 0):
+        kwargs = {"bias_correction": False} if estimator == "totdev" else {}
+        fixed = getattr(avar, estimator)(y, taus="decade", alpha=alpha, **kwargs)
+        assert fixed.alpha.tolist() == [alpha] * free.taus.size
+        np.testing.assert_array_equal(fixed.deviation, free.deviation)
+        edf = estimator_edf(estimator, fixed.alpha, fixed.averaging_factors, y.size + 1)
+        np.testing.assert_allclose(fixed.edf, edf, rtol=1e-14)
+        lci, uci = chi2_bounds(fixed.deviation, edf, 0.683, quantiles=CATALOGUE_QUANTILES)
+        np.testing.assert_allclose(fixed.lci, lci, rtol=1e-14)
+        np.testing.assert_allclose(fixed.uci, uci, rtol=1e-14)
+
+
+def test_totdev_with_a_fixed_flicker_fm_removes_the_bias_at_every_level():
+    y = np.random.default_rng(6).standard_normal(1000)
+    raw = avar.totdev(y, alpha=-1, bias_correction=False)
+    unbiased = avar.totdev(y, alpha=-1)
+    m = raw.averaging_factors
+    np.testing.assert_allclose(unbiased.variance, raw.variance / (1 - m / (3 * np.log(2)) / 1000), rtol=1e-14)
+    np.testing.assert_array_equal(avar.totdev(y, alpha=0).deviation, raw.deviation)  # white FM: no bias

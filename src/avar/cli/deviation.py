@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
     for name, function in zip(stats, functions):
         progress(f"computing {name}")
         results.append(function(values, rate=rate, data_type=args.data_type, taus=args.taus,
-                                confidence=args.confidence, nan_policy=args.nan_policy))
+                                confidence=args.confidence, nan_policy=args.nan_policy, alpha=args.noise))
     source = f"{Path(args.file).name} [{column}]"
 
     def csv() -> str:
@@ -103,6 +103,9 @@ def add_parser(commands) -> None:
     parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help="tau grid")
     parser.add_argument("--column", metavar="NAME", help="the data column (needed when there are several)")
     parser.add_argument("--confidence", type=float, default=0.683, help="confidence of Min/Max Sigma (0.683)")
+    parser.add_argument("--noise", type=int, choices=[2, 1, 0, -1, -2], metavar="ALPHA",
+                        help="fix the noise exponent alpha at every level, as Stable32 allows (2 white PM, "
+                             "1 flicker PM, 0 white FM, -1 flicker FM, -2 random-walk FM); default: identified")
     parser.add_argument("--nan-policy", choices=["raise", "omit"], default="raise",
                         help="NaN (gaps) in the data: refuse, or skip the terms that touch them")
     parser.add_argument("--time-unit", choices=["s", "ms", "us", "ns"], default=None,

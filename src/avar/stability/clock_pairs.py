@@ -17,10 +17,11 @@ import numpy as np
 
 from avar._kernels.time_error import codev_levels
 from avar.stability.chi2 import CATALOGUE_QUANTILES, chi2_bounds
+from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_options
 from avar.stability.deviation_results import Deviation
-from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options
 from avar.stability.grids import grid_factors
-from avar.stability.time_error import check_alpha, level_noise, prepared_phase
+from avar.stability.noise_types import check_alpha
+from avar.stability.time_error import level_noise, prepared_phase
 
 #: Statistics the three-cornered hat accepts (variances of one clock that add over independent clocks).
 HAT_STATISTICS = ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "pdev")
@@ -116,9 +117,9 @@ def three_cornered_hat(ab: Any, bc: Any, ca: Any, rate: float = 1.0, data_type: 
 
 
 def _named_check(data: Any, name: str, data_type: str, nan_policy: str) -> np.ndarray:
-    """:func:`_check_data` with the argument's own name in its messages."""
+    """:func:`avar.stability.deviation_inputs.check_data` with the argument's own name in its messages."""
     try:
-        return _check_data(data, data_type, nan_policy)[0]
+        return check_data(data, data_type, nan_policy)[0]
     except (TypeError, ValueError) as error:
         raise type(error)(str(error).replace("data", name, 1)) from None
 
@@ -166,7 +167,7 @@ def gcodev(data_1: Any, data_2: Any, rate: float = 1.0, data_type: str = "freq",
     >>> round(float(res.variance[0]), 1)
     1.0
     """
-    rate = _check_options("gcodev", rate, data_type, confidence, nan_policy)
+    rate = check_options("gcodev", rate, data_type, confidence, nan_policy)
     fixed = check_alpha(alpha)
     first, second = (_named_check(data, name, data_type, nan_policy)
                      for data, name in ((data_1, "data_1"), (data_2, "data_2")))

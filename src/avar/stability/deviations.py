@@ -25,25 +25,19 @@ rate, m the averaging factor, tau = m tau0):
 
 from __future__ import annotations
 
-import numbers
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
-from avar._kernels.deviation_phase import scan
-from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, rate_from_index, short_repr
 from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_core import OctaveMoments, deviation_levels_and_phase
 from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors, levels_with_terms
+from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_options, rate_of, scaled
 from avar.stability.deviation_results import Deviation
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.noise_id import NOISE_ID_ESTIMATORS, identify_noise, octave_noise, phase_noise
+from avar.stability.noise_types import ALPHA_PARAMETER, check_alpha
 from avar.stability.total_edf import totvar_bias
-
-DATA_TYPES = ("freq", "phase")
-NAN_POLICIES = ("raise", "omit")
-DEFAULT_CONFIDENCE = 0.683
 
 _PARAMETERS = """
     Parameters
@@ -75,79 +69,6 @@ _PARAMETERS = """
         ``taus``, ``deviation``, ``variance``, ``n``, ``alpha``, ``edf``,
         ``lci``, ``uci``, ``summary()``, ``plot()``.
 """
-
-
-def _check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False) -> tuple[np.ndarray, tuple]:
-    """Float64 values of ``data`` and their :func:`scan` (NaN count, sum, min, max, and with
-    ``weigh`` the centred moment), or an error naming ``data``."""
-    if isinstance(data, pd.DataFrame):
-        raise TypeError("data is a DataFrame; give one column (a 1-D series) of phase or frequency data")
-    if isinstance(data, pd.Series):
-        data = data.to_numpy()
-    if isinstance(data, (str, bytes)):
-        raise TypeError("data must be a numeric 1-D array of phase or frequency data, got a string")
-    array = as_array(data, "data")
-    check_numeric_dtype(array, "data")
-    if array.ndim != 1:
-        raise ValueError(f"data must be 1-D, got an array of shape {array.shape}")
-    values = np.ascontiguousarray(as_float64(array), dtype=np.float64)
-    if not values.flags.writeable:  # one compiled signature of the kernels
-        values = values.copy()
-    scanned = scan(values, weigh=weigh) if values.size else (0, 0.0, np.inf, -np.inf, np.nan)  # one pass
-    if np.isinf(scanned[2]) and scanned[0] < values.size or np.isinf(scanned[3]) and scanned[0] < values.size:
-        infinite = np.flatnonzero(np.isinf(values))
-        raise ValueError(f"data has {infinite.size} infinite value(s), the first at index {infinite[0]}; "
-                         "infinite values are never accepted (NaN marks a gap, see nan_policy)")
-    n_missing = int(scanned[0])
-    if n_missing and nan_policy == "raise":
-        missing = np.flatnonzero(np.isnan(values))
-        raise ValueError(f"data has {n_missing} NaN value(s), the first at index {missing[0]}; pass "
-                         "nan_policy='omit' to skip the terms that touch them, or remove/fill them")
-    if n_missing == values.size:
-        raise ValueError("data holds only NaN values")
-    return values, scanned
-
-
-def _rate_of(data: Any, rate: Any) -> float:
-    """``rate``, else the rate of a pandas Series' time index, else 1 Hz."""
-    if rate is not None:
-        return check_freq(rate, "rate")
-    if isinstance(data, pd.Series):
-        index_rate = rate_from_index(data.index, "data")
-        if index_rate is not None:
-            return index_rate
-    return 1.0
-
-
-def _check_options(estimator: str, rate: Any, data_type: Any, confidence: Any, nan_policy: Any) -> float:
-    if not isinstance(data_type, str) or data_type not in DATA_TYPES:
-        raise ValueError(f"data_type must be 'freq' (fractional frequency) or 'phase' (time error, s), "
-                         f"got {short_repr(data_type)}")
-    if not isinstance(nan_policy, str) or nan_policy not in NAN_POLICIES:
-        raise ValueError(f"nan_policy must be 'raise' or 'omit', got {short_repr(nan_policy)}")
-    if isinstance(confidence, (bool, np.bool_)) or not isinstance(confidence, numbers.Real):
-        raise TypeError(f"confidence must be a number in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
-    if not 0.0 < float(confidence) < 1.0:
-        raise ValueError(f"confidence must be in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
-    return rate
-
-
-#: Data beyond 2**+-SCALE_LIMIT are scaled by a power of two (exact) before any square is formed.
-SCALE_LIMIT = 400
-
-
-def _scaled(values: np.ndarray, scanned: tuple, weigh: bool) -> tuple[np.ndarray, tuple, int]:
-    """``values`` scaled by 2**-e to magnitude ~1 when near the float64 limits (squares of data near
-    1e-300 underflow to 0, of data near 1e300 overflow), with their scan and e (0: unscaled).
-
-    The deviation is then exact; the variance is its square correctly rounded (0 or subnormal for
-    data near 1e-300), and a variance beyond the float64 maximum is an error."""
-    big = max(abs(float(scanned[2])), abs(float(scanned[3])))
-    if not np.isfinite(big) or big == 0 or 2.0 ** -SCALE_LIMIT < big < 2.0 ** SCALE_LIMIT:
-        return values, scanned, 0
-    exponent = int(np.frexp(big)[1])
-    values = np.ldexp(values, -exponent)
-    return values, scan(values, weigh=weigh), exponent
 
 
 def _longest_stretch(values: np.ndarray) -> np.ndarray:
@@ -188,20 +109,22 @@ def _noise_of_levels(estimator: str, phase: np.ndarray | OctaveMoments, drift: f
 
 
 def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, confidence: Any,
-              nan_policy: Any, bias_correction: Any = False) -> Deviation:
-    """Validate once, compute the variances, identify the noise, remove TOTVAR's bias, bound the deviation."""
+              nan_policy: Any, alpha: Any = None, bias_correction: Any = False) -> Deviation:
+    """Validate once, compute the variances, identify the noise (unless ``alpha`` fixes it), remove
+    TOTVAR's bias, bound the deviation."""
     if not isinstance(bias_correction, (bool, np.bool_)):
         raise TypeError(f"bias_correction must be True or False, got {bias_correction!r}")
-    rate = _check_options(estimator, _rate_of(data, rate), data_type, confidence, nan_policy)
+    fixed = check_alpha(alpha)
+    rate = check_options(estimator, rate_of(data, rate), data_type, confidence, nan_policy)
     drift_removed = estimator in ("hdev", "ohdev") and data_type == "freq"  # the scan finds the drift too
-    values, scanned = _check_data(data, data_type, nan_policy, weigh=drift_removed)
+    values, scanned = check_data(data, data_type, nan_policy, weigh=drift_removed)
     n_missing = int(scanned[0])
     n_phase = values.size + (data_type == "freq")
     needed = MIN_PHASE_POINTS[estimator] - (data_type == "freq")
     if values.size < needed:
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
     factors = deviation_factors(estimator, n_phase, rate, taus)
-    values, scanned, exponent = _scaled(values, scanned, drift_removed)
+    values, scanned, exponent = scaled(values, scanned, drift_removed)
     variance, n, phase, drift = deviation_levels_and_phase(estimator, values, factors, data_type, rate, scanned)
     n, variance, factors = levels_with_terms(estimator, n, (variance, factors),
                                              f"the {n_missing} NaN value(s) of data" if n_missing else None)
@@ -213,7 +136,9 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
             raise ValueError(f"the {estimator} variance of data of magnitude {2.0 ** exponent:.3g} is beyond the "
                              f"float64 range (the deviation reaches {deviation.max():.3g}); rescale the data, "
                              "e.g. to other units")
-    if n_missing:
+    if fixed is not None:
+        alpha = np.full(factors.size, fixed, dtype=np.int64)
+    elif n_missing:
         alpha = noise_exponents(estimator, values, data_type, rate, factors)
     else:  # the variances' own detrended phase: no second pass over the data
         alpha = _noise_of_levels(estimator, phase, drift, factors)
@@ -232,7 +157,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
 
 
 def adev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
-         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Allan deviation (non-overlapping), NIST SP 1065 eq. (7)::
 
         sigma_y^2(tau) = sum_{k} (x_{(k+2)m} - 2 x_{(k+1)m} + x_{km})^2 / (2 tau^2 n),
@@ -253,11 +178,11 @@ def adev(data: Any, rate: float | None = None, data_type: str = "freq", taus: An
     >>> res.deviation.round(6).tolist()  # sqrt((4 + 1 + 4 + 1 + 4 + 1) / (2 * 6)), ...
     [1.118034, 0.707107]
     """
-    return _estimate("adev", data, rate, data_type, taus, confidence, nan_policy)
+    return _estimate("adev", data, rate, data_type, taus, confidence, nan_policy, alpha)
 
 
 def oadev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
-          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Overlapping Allan deviation, NIST SP 1065 eq. (11)::
 
         sigma_y^2(tau) = sum_{i=0}^{N-2m-1} (x_{i+2m} - 2 x_{i+m} + x_i)^2 / (2 tau^2 (N - 2m)),
@@ -277,11 +202,11 @@ def oadev(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
     >>> res.deviation.round(6).tolist()
     [1.118034, 0.707107, 1.118034]
     """
-    return _estimate("oadev", data, rate, data_type, taus, confidence, nan_policy)
+    return _estimate("oadev", data, rate, data_type, taus, confidence, nan_policy, alpha)
 
 
 def mdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
-         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Modified Allan deviation, NIST SP 1065 eq. (14)::
 
         Mod sigma_y^2(tau) = sum_{j=0}^{N-3m} [sum_{i=j}^{j+m-1} (x_{i+2m} - 2 x_{i+m} + x_i)]^2 / (2 m^2 tau^2 (N - 3m + 1)),
@@ -300,11 +225,11 @@ def mdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: An
     >>> res.averaging_factors.tolist(), res.n.tolist(), res.deviation.round(6).tolist()
     ([1, 2], [6, 3], [1.118034, 0.707107])
     """
-    return _estimate("mdev", data, rate, data_type, taus, confidence, nan_policy)
+    return _estimate("mdev", data, rate, data_type, taus, confidence, nan_policy, alpha)
 
 
 def tdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
-         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Time deviation, NIST SP 1065 eq. (15): sigma_x(tau) = tau / sqrt(3) Mod sigma_y(tau), in seconds.
 
     Same terms and levels as :func:`mdev`.
@@ -320,11 +245,11 @@ def tdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: An
     >>> res.taus.tolist(), res.deviation.round(6).tolist()  # 0.5 s / sqrt(3) * 1.118034, ...
     ([0.5, 1.0], [0.322749, 0.408248])
     """
-    return _estimate("tdev", data, rate, data_type, taus, confidence, nan_policy)
+    return _estimate("tdev", data, rate, data_type, taus, confidence, nan_policy, alpha)
 
 
 def hdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
-         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+         confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Hadamard deviation (non-overlapping), NIST SP 1065 eq. (18)::
 
         H sigma_y^2(tau) = sum_{k} (x_{(k+3)m} - 3 x_{(k+2)m} + 3 x_{(k+1)m} - x_{km})^2 / (6 tau^2 n),
@@ -343,11 +268,11 @@ def hdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: An
     >>> res.n.tolist(), res.deviation.round(6).tolist()
     ([6, 2], [1.224745, 0.0])
     """
-    return _estimate("hdev", data, rate, data_type, taus, confidence, nan_policy)
+    return _estimate("hdev", data, rate, data_type, taus, confidence, nan_policy, alpha)
 
 
 def ohdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
-          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise") -> Deviation:
+          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Overlapping Hadamard deviation, NIST SP 1065 eq. (20)::
 
         H sigma_y^2(tau) = sum_{i=0}^{N-3m-1} (x_{i+3m} - 3 x_{i+2m} + 3 x_{i+m} - x_i)^2 / (6 tau^2 (N - 3m)),
@@ -365,11 +290,12 @@ def ohdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
     >>> res.n.tolist(), res.deviation.round(6).tolist()
     ([6, 3], [1.224745, 0.0])
     """
-    return _estimate("ohdev", data, rate, data_type, taus, confidence, nan_policy)
+    return _estimate("ohdev", data, rate, data_type, taus, confidence, nan_policy, alpha)
 
 
 def totdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
-           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", bias_correction: bool = True) -> Deviation:
+           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
+           bias_correction: bool = True) -> Deviation:
     """Total deviation, NIST SP 1065 eq. (25)::
 
         Tot sigma_y^2(tau) = sum_{i=2}^{N-1} (x*_{i-m} - 2 x*_i + x*_{i+m})^2 / (2 tau^2 (N - 2)),
@@ -394,7 +320,7 @@ def totdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: 
     >>> avar.totdev([1.0, 3.0, 2.0, 4.0, 3.0, 5.0, 4.0], taus=[1, 6]).alpha.tolist()  # flicker FM: / (1 - a m / N)
     [-1, -1]
     """
-    return _estimate("totdev", data, rate, data_type, taus, confidence, nan_policy, bias_correction)
+    return _estimate("totdev", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
 
 
 _TOTDEV_BIAS = """    bias_correction : bool
@@ -406,6 +332,7 @@ _TOTDEV_BIAS = """    bias_correction : bool
         gives the raw statistic, as ``allantools``.
 """
 for _function in (adev, oadev, mdev, tdev, hdev, ohdev, totdev):
-    _parameters = _PARAMETERS.replace("\n\n    Returns", "\n" + _TOTDEV_BIAS + "\n    Returns") if _function is totdev else _PARAMETERS
+    _extra = ALPHA_PARAMETER + (_TOTDEV_BIAS if _function is totdev else "")
+    _parameters = _PARAMETERS.replace("\n\n    Returns", "\n" + _extra + "\n    Returns")
     _function.__doc__ = _function.__doc__.replace("{parameters}", _parameters)
-del _function, _parameters
+del _function, _parameters, _extra

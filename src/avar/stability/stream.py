@@ -20,11 +20,11 @@ from avar._kernels.stream import stream_update
 from avar._validation import check_freq, short_repr
 from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import term_counts
+from avar.stability.deviation_inputs import DATA_TYPES, DEFAULT_CONFIDENCE, check_data
 from avar.stability.deviation_results import Deviation
-from avar.stability.deviations import DATA_TYPES, DEFAULT_CONFIDENCE, _check_data
 from avar.stability.edf import chi2_bounds, estimator_edf
 from avar.stability.grids import grid_factors
-from avar.stability.time_error import check_alpha
+from avar.stability.noise_types import check_alpha
 
 #: Statistic -> (kernel kind, points spanned per m, divisor K of the variance).
 STREAM_STATISTICS = {"oadev": (0, 2, 2.0), "adev": (1, 2, 2.0), "ohdev": (2, 3, 6.0), "hdev": (3, 3, 6.0),
@@ -99,7 +99,7 @@ class Stream:
 
     def update(self, chunk: Any) -> Stream:
         """Add the samples of ``chunk`` (1-D, finite) and return the stream."""
-        values, scanned = _check_data(chunk, self.data_type, "raise") if np.size(chunk) else (np.zeros(0), None)
+        values, scanned = check_data(chunk, self.data_type, "raise") if np.size(chunk) else (np.zeros(0), None)
         stream_update(values, self.data_type == "freq", self._kind, self._state, self._ring_hi, self._ring_lo,
                       self.factors, self._sums, self._comps, self._counts, self._dring, self._doffsets,
                       self._dsum, self._dcount)

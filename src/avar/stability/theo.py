@@ -20,11 +20,13 @@ from avar._kernels.theo_levels import theo1_sums
 from avar._kernels.total import theo1_sum
 from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import deviation_factors
+from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE
 from avar.stability.deviation_results import Deviation
-from avar.stability.deviations import DEFAULT_CONFIDENCE, noise_exponents
+from avar.stability.deviations import noise_exponents
 from avar.stability.edf import chi2_bounds, estimator_edf
+from avar.stability.noise_types import check_alpha
 from avar.stability.theobr import MIN_THEOBR_POINTS, theobr_factor
-from avar.stability.total import check_alpha, prepared_phase
+from avar.stability.total import prepared_phase
 from avar.stability.total_edf import total_edf, total_factors
 
 #: Stable32's ThêoH table: OADEV at its own factors (m <= N / 4) and Theo1 from m = floor(N / THEO_FROM).

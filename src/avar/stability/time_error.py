@@ -10,38 +10,19 @@ identifying it (as Stable32 allows).
 
 from __future__ import annotations
 
-import numbers
 from typing import Any
 
 import numpy as np
 
 from avar._kernels.time_error import mtie_levels, pdev_levels, tierms_levels
-from avar._validation import short_repr
 from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import levels_with_terms
+from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_options
 from avar.stability.deviation_results import Deviation
-from avar.stability.deviations import _check_data, _check_options, _noise_of_levels, noise_exponents
+from avar.stability.deviations import _noise_of_levels, noise_exponents
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.grids import grid_factors
-
-DEFAULT_CONFIDENCE = 0.683
-_EXTRA_PARAMETERS = """    alpha : int or None
-        Power-law noise exponent (2 white PM .. -2 random-walk FM) of every
-        level; None (default) identifies it per level by the lag-1
-        autocorrelation (:func:`avar.stability.noise_id.identify_noise`).
-"""
-
-
-def check_alpha(alpha: Any) -> int | None:
-    """``alpha=``: None or an integer in -2 .. 2."""
-    if alpha is None:
-        return None
-    if isinstance(alpha, (bool, np.bool_)) or not isinstance(alpha, numbers.Integral):
-        raise TypeError(f"alpha must be None or an integer noise exponent in -2 .. 2, got {short_repr(alpha)}")
-    if not -2 <= int(alpha) <= 2:
-        raise ValueError(f"alpha must be in -2 .. 2 (2 white PM, 1 flicker PM, 0 white FM, -1 flicker FM, "
-                         f"-2 random-walk FM), got {int(alpha)}")
-    return int(alpha)
+from avar.stability.noise_types import ALPHA_PARAMETER, check_alpha
 
 
 def prepared_phase(values: np.ndarray, data_type: str, rate: float) -> tuple[np.ndarray, np.ndarray, int]:
@@ -75,9 +56,9 @@ def largest_factor(statistic: str, n_phase: int) -> int:
 
 def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, confidence: Any,
               nan_policy: Any, alpha: Any) -> Deviation:
-    rate = _check_options(statistic, rate, data_type, confidence, nan_policy)
+    rate = check_options(statistic, rate, data_type, confidence, nan_policy)
     fixed = check_alpha(alpha)
-    values, scanned = _check_data(data, data_type, nan_policy)
+    values, scanned = check_data(data, data_type, nan_policy)
     n_phase = values.size + (data_type == "freq")
     if n_phase < 3:
         raise ValueError(f"data has {values.size} sample(s); {statistic} of {data_type} data needs at least "
@@ -256,7 +237,7 @@ def _with_parameters(function):
     from avar.stability.deviations import _PARAMETERS
 
     head, returns = _PARAMETERS.split("\n    Returns")
-    function.__doc__ = function.__doc__.replace("{parameters}", head + _EXTRA_PARAMETERS + "\n    Returns" + returns)
+    function.__doc__ = function.__doc__.replace("{parameters}", head + ALPHA_PARAMETER + "\n    Returns" + returns)
     return function
 
 

@@ -23,8 +23,10 @@ from avar._kernels.total import level_sums, theo1_sum
 from avar.stability.chi2 import CATALOGUE_QUANTILES, chi2_bounds
 from avar.stability.deviation_core import phase_parts
 from avar.stability.deviation_grids import levels_with_terms
+from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_options
 from avar.stability.deviation_results import Deviation
-from avar.stability.deviations import DEFAULT_CONFIDENCE, _check_data, _check_options, noise_exponents
+from avar.stability.deviations import noise_exponents
+from avar.stability.noise_types import ALPHA_PARAMETER, check_alpha
 from avar.stability.theobr import MIN_THEOBR_POINTS, theobr_factor
 from avar.stability.total_edf import (
     MTOT_EDF,
@@ -61,27 +63,11 @@ _PARAMETERS = """
     nan_policy : {"raise", "omit"}
         ``"omit"``: every term (window) touching a gap is skipped; ``n`` counts
         the terms used and the EDF is scaled by the fraction used.
-    alpha : int or None
-        The power-law noise exponent (2 white PM .. -2 random-walk FM) of every
-        level, as Stable32's fixed noise type; None identifies it per level
-        (:func:`avar.stability.noise_id.identify_noise`).
-
+{alpha}
     Returns
     -------
     Deviation
 """
-
-
-def check_alpha(alpha: Any) -> int | None:
-    """None or an integer noise exponent in -2 .. 2, or an error naming ``alpha``."""
-    if alpha is None:
-        return None
-    if isinstance(alpha, (bool, np.bool_)) or not isinstance(alpha, (int, np.integer)):
-        raise TypeError(f"alpha must be None or an integer in -2 .. 2 (the noise exponent), got {alpha!r}")
-    if not -2 <= int(alpha) <= 2:
-        raise ValueError(f"alpha must be in -2 .. 2 (2 white PM, 1 flicker PM, 0 white FM, -1 flicker FM, "
-                         f"-2 random-walk FM), got {int(alpha)}")
-    return int(alpha)
 
 
 def _check_bias(bias_correction: Any, estimator: str) -> bool | str | None:
@@ -98,8 +84,8 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
     """Validate once: ``values, rate, x, bad, shift, scale, n_phase``; ``x`` the detrended phase
     (scaled by ``scale``, a power of two; HTOTDEV: its linear frequency drift removed too, as
     every statistic here is blind to it) with gaps filled, ``bad`` their prefix count."""
-    rate = _check_options(estimator, rate, data_type, confidence, nan_policy)
-    values, scanned = _check_data(data, data_type, nan_policy)
+    rate = check_options(estimator, rate, data_type, confidence, nan_policy)
+    values, scanned = check_data(data, data_type, nan_policy)
     needed = _MIN_PHASE.get(estimator, 3) - (data_type == "freq")
     if values.size < needed:
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
@@ -346,6 +332,6 @@ def theo1(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
 
 
 for _function in (mtotdev, ttotdev, htotdev, theo1):
-    _function.__doc__ = _function.__doc__.replace("{parameters}", _PARAMETERS)
+    _function.__doc__ = _function.__doc__.replace("{parameters}", _PARAMETERS.replace("{alpha}", ALPHA_PARAMETER))
 del _function
 assert set(MTOT_EDF) == set(MTOT_BIAS)

@@ -1,0 +1,98 @@
+"""The inputs every deviation statistic shares: the data, its rate, and the options.
+
+Validation happens here once, at the public boundary (:mod:`avar.stability.deviations`,
+:mod:`avar.stability.total`, :mod:`avar.stability.time_error`, ...); the kernels
+below trust what they are given.
+"""
+
+from __future__ import annotations
+
+import numbers
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from avar._kernels.deviation_phase import scan
+from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, rate_from_index, short_repr
+from avar.stability.chi2 import DEFAULT_CONFIDENCE
+
+__all__ = ["DATA_TYPES", "DEFAULT_CONFIDENCE", "NAN_POLICIES", "SCALE_LIMIT", "check_data", "check_options",
+           "rate_of", "scaled"]
+
+DATA_TYPES = ("freq", "phase")
+NAN_POLICIES = ("raise", "omit")
+
+
+def check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False) -> tuple[np.ndarray, tuple]:
+    """Float64 values of ``data`` and their :func:`scan` (NaN count, sum, min, max, and with
+    ``weigh`` the centred moment), or an error naming ``data``."""
+    if isinstance(data, pd.DataFrame):
+        raise TypeError("data is a DataFrame; give one column (a 1-D series) of phase or frequency data")
+    if isinstance(data, pd.Series):
+        data = data.to_numpy()
+    if isinstance(data, (str, bytes)):
+        raise TypeError("data must be a numeric 1-D array of phase or frequency data, got a string")
+    array = as_array(data, "data")
+    check_numeric_dtype(array, "data")
+    if array.ndim != 1:
+        raise ValueError(f"data must be 1-D, got an array of shape {array.shape}")
+    values = np.ascontiguousarray(as_float64(array), dtype=np.float64)
+    if not values.flags.writeable:  # one compiled signature of the kernels
+        values = values.copy()
+    scanned = scan(values, weigh=weigh) if values.size else (0, 0.0, np.inf, -np.inf, np.nan)  # one pass
+    if np.isinf(scanned[2]) and scanned[0] < values.size or np.isinf(scanned[3]) and scanned[0] < values.size:
+        infinite = np.flatnonzero(np.isinf(values))
+        raise ValueError(f"data has {infinite.size} infinite value(s), the first at index {infinite[0]}; "
+                         "infinite values are never accepted (NaN marks a gap, see nan_policy)")
+    n_missing = int(scanned[0])
+    if n_missing and nan_policy == "raise":
+        missing = np.flatnonzero(np.isnan(values))
+        raise ValueError(f"data has {n_missing} NaN value(s), the first at index {missing[0]}; pass "
+                         "nan_policy='omit' to skip the terms that touch them, or remove/fill them")
+    if n_missing == values.size:
+        raise ValueError("data holds only NaN values")
+    return values, scanned
+
+
+def rate_of(data: Any, rate: Any) -> float:
+    """``rate``, else the rate of a pandas Series' time index, else 1 Hz."""
+    if rate is not None:
+        return check_freq(rate, "rate")
+    if isinstance(data, pd.Series):
+        index_rate = rate_from_index(data.index, "data")
+        if index_rate is not None:
+            return index_rate
+    return 1.0
+
+
+def check_options(estimator: str, rate: Any, data_type: Any, confidence: Any, nan_policy: Any) -> float:
+    """``rate`` back once ``data_type``, ``confidence`` and ``nan_policy`` hold, or an error naming the argument."""
+    if not isinstance(data_type, str) or data_type not in DATA_TYPES:
+        raise ValueError(f"data_type must be 'freq' (fractional frequency) or 'phase' (time error, s), "
+                         f"got {short_repr(data_type)}")
+    if not isinstance(nan_policy, str) or nan_policy not in NAN_POLICIES:
+        raise ValueError(f"nan_policy must be 'raise' or 'omit', got {short_repr(nan_policy)}")
+    if isinstance(confidence, (bool, np.bool_)) or not isinstance(confidence, numbers.Real):
+        raise TypeError(f"confidence must be a number in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
+    if not 0.0 < float(confidence) < 1.0:
+        raise ValueError(f"confidence must be in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
+    return rate
+
+
+#: Data beyond 2**+-SCALE_LIMIT are scaled by a power of two (exact) before any square is formed.
+SCALE_LIMIT = 400
+
+
+def scaled(values: np.ndarray, scanned: tuple, weigh: bool) -> tuple[np.ndarray, tuple, int]:
+    """``values`` scaled by 2**-e to magnitude ~1 when near the float64 limits (squares of data near
+    1e-300 underflow to 0, of data near 1e300 overflow), with their scan and e (0: unscaled).
+
+    The deviation is then exact; the variance is its square correctly rounded (0 or subnormal for
+    data near 1e-300), and a variance beyond the float64 maximum is an error."""
+    big = max(abs(float(scanned[2])), abs(float(scanned[3])))
+    if not np.isfinite(big) or big == 0 or 2.0 ** -SCALE_LIMIT < big < 2.0 ** SCALE_LIMIT:
+        return values, scanned, 0
+    exponent = int(np.frexp(big)[1])
+    values = np.ldexp(values, -exponent)
+    return values, scan(values, weigh=weigh), exponent
