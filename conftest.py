@@ -22,9 +22,10 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 # pytest.approx(x, rel=r) also accepts anything within 1e-12 of x: for the 1e-13 deviations
 # of clocks and the 1e-15 variances of good gyros that makes every comparison pass. Here it is
 # relative alone unless a test names its own abs.
-from _pytest.python_api import ApproxScalar  # noqa: E402
-
-ApproxScalar.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
+_APPROX_SCALAR = type(pytest.approx(1.0))  # pytest's class; its module moved between versions
+_APPROX_SCALAR.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
+if 1e-15 == pytest.approx(2e-15, rel=1e-6):  # a pytest that reads its tolerance elsewhere: say so
+    raise RuntimeError("conftest.py could not make pytest.approx relative; check DEFAULT_ABSOLUTE_TOLERANCE")
 
 # Shared test helpers (tests/reference.py) import as top-level modules.
 sys.path.insert(0, str(Path(__file__).resolve().parent / "tests"))
