@@ -16,13 +16,13 @@ import numpy as np
 
 from avar._validation import as_series, short_repr
 from avar.stability.deviation_core import deviation_levels
+from avar.stability.deviation_inputs import NAN_POLICIES
 from avar.stability.deviations import noise_exponents
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.grids import averaging_factors
 from avar.stability.intervals import relative_errors
 from avar.stability.results import AllanVariance
 
-NAN_POLICIES = ("raise", "omit")
 TYPE_ESTIMATORS = {"mo": "oadev", "to": "adev"}
 
 
