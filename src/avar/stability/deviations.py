@@ -328,8 +328,8 @@ _TOTDEV_BIAS = """    bias_correction : bool
         random-walk FM: E[TOTVAR] / AVAR = 1 - a tau / T, T = N tau0 (N the
         number of phase or frequency points given, as Stable32), a = 1 /
         (3 ln 2) and 3 / 4 (Howe 1999). ``True`` (default, as Stable32)
-        divides by it at the levels identified as alpha = -1, -2; ``False``
-        gives the raw statistic, as ``allantools``.
+        divides by it at the levels whose alpha (identified or fixed) is
+        -1 or -2; ``False`` gives the raw statistic, as ``allantools``.
 """
 for _function in (adev, oadev, mdev, tdev, hdev, ohdev, totdev):
     _extra = ALPHA_PARAMETER + (_TOTDEV_BIAS if _function is totdev else "")
