@@ -114,3 +114,12 @@ def fsum_variance(estimator: str, data, m: int, data_type: str = "phase", rate: 
     if estimator == "tdev":
         variance *= tau * tau / 3
     return variance, len(values)
+
+
+def nbs14_1000() -> np.ndarray:
+    """NIST SP 1065 section 12: n(i) = 16807 n(i-1) mod 2147483647, n(0) = 1234567890, y = n / 2147483647."""
+    n = [1234567890]
+    for _ in range(999):
+        n.append(16807 * n[-1] % 2147483647)
+    assert n[1:4] == [395529916, 1209410747, 633705974]
+    return np.array(n, dtype=np.float64) / 2147483647

@@ -8,7 +8,7 @@ import allantools
 import numpy as np
 import pandas as pd
 import pytest
-from deviation_reference import exact_variance, fsum_variance
+from deviation_reference import exact_variance, fsum_variance, nbs14_1000
 
 import avar
 from avar.stability.deviation_grids import ESTIMATORS, deviation_factors, max_factor
@@ -106,15 +106,6 @@ def test_fsum_loop_larger(estimator):
         expected, count = fsum_variance(estimator, data, int(m), "freq")
         assert n == count
         assert variance == pytest.approx(expected, rel=1e-10)
-
-
-def nbs14_1000() -> np.ndarray:
-    """NIST SP 1065 section 12: n(i) = 16807 n(i-1) mod 2147483647, n(0) = 1234567890, y = n / 2147483647."""
-    n = [1234567890]
-    for _ in range(999):
-        n.append(16807 * n[-1] % 2147483647)
-    assert n[1:4] == [395529916, 1209410747, 633705974]
-    return np.array(n, dtype=np.float64) / 2147483647
 
 
 #: NIST SP 1065, table of the 1000-point test suite (tau = 1, 10, 100), as printed.

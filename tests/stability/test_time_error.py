@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import avar
+from tests.deviation_reference import nbs14_1000
 
 
 def _phase(data, data_type, rate):
@@ -197,3 +198,18 @@ def test_stable32_tables_of_phase_dat(name):
     res = getattr(avar, name)(x, rate=1.0, data_type="phase", taus=rows[:, 0])
     assert res.n.tolist() == rows[:, 1].astype(int).tolist()
     np.testing.assert_allclose(res.deviation, rows[:, 2], rtol=5e-5)  # Stable32 prints 5 digits
+
+
+#: SigmaTheta v3.0 (FEMTO-ST) on NIST's 1000-point NBS14 frequency record, kept in allantools'
+#: tests: PDEV at (AF, value) to 17 digits, an implementation independent of allantools.
+SIGMATHETA_NBS14_PDEV = [(1, 2.9223187810675200e-01), (2, 2.1445233564252639e-01), (4, 1.5618112158618463e-01),
+                         (8, 1.1709745745448434e-01), (16, 6.9029585189839343e-02), (32, 4.9749707730398392e-02),
+                         (64, 3.8947417330713739e-02), (128, 3.0862392741372108e-02), (256, 1.2447414341332683e-02),
+                         (500, 9.3531187831254377e-04)]
+
+
+def test_pdev_equals_sigmatheta_on_nbs14():
+    rows = np.array(SIGMATHETA_NBS14_PDEV)
+    res = avar.pdev(nbs14_1000(), taus=rows[:, 0])
+    assert res.n.tolist() == [1001 - 2 * int(m) for m in rows[:, 0]]  # N - 2m windows of the N = 1001 phase points
+    np.testing.assert_allclose(res.deviation, rows[:, 1], rtol=1e-10)  # 1e-11 at m = 500 (a single window)
