@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 
 import avar
+from avar.stability.statistics import DEVIATION_STATISTICS
 from tests.cli_runner import cli
 
 RNG = np.random.default_rng(2027)
@@ -105,7 +106,9 @@ def test_two_time_columns_with_different_rates_are_a_conflict(tmp_path, capsys):
 
 
 # --------------------------------------------------------------------------- time indexes
-DEVIATIONS = [avar.adev, avar.oadev, avar.mdev, avar.tdev, avar.hdev, avar.ohdev, avar.totdev]
+DEVIATIONS = [getattr(avar, name) for name in DEVIATION_STATISTICS]
+#: The seven that rescale data near the float64 limits themselves (the others refuse tiny data).
+CLASSIC = ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")
 
 
 @pytest.mark.parametrize("estimator", DEVIATIONS, ids=lambda f: f.__name__)
@@ -113,12 +116,27 @@ def test_every_deviation_takes_the_rate_of_a_time_index(estimator):
     series = pd.Series(X, index=pd.date_range("2026-01-01", periods=X.size, freq="10ms"))
     got, want = estimator(series), estimator(X, rate=100.0)
     np.testing.assert_array_equal(got.taus, want.taus)
-    assert got.taus[0] == pytest.approx(0.01)
+    assert got.rate == 100.0 and got.taus[0] == pytest.approx(0.015 if estimator.__name__ == "theo1" else 0.01)
     np.testing.assert_allclose(got.deviation, want.deviation, rtol=1e-12)
-    assert estimator(series, rate=1.0).taus[0] == 1.0  # an explicit rate wins, as freq in avar.avar
+    explicit = estimator(series, rate=1.0)  # an explicit rate wins, as freq in avar.avar
+    assert explicit.rate == 1.0 and np.allclose(explicit.taus, got.taus * 100.0, rtol=1e-12, atol=0)
     gappy = pd.Series(np.delete(X, 700), index=series.index.delete(700))  # a missing sample: a 20 ms step
     with pytest.raises(ValueError, match=r"data has an irregular time index \(steps from 10000 to 20000 us\)"):
         estimator(gappy)
+
+
+@pytest.mark.parametrize("estimator", DEVIATIONS, ids=lambda f: f.__name__)
+@pytest.mark.parametrize("rate, error", [(0.0, ValueError), (-2.0, ValueError), (np.inf, ValueError), ("1", TypeError)])
+def test_every_deviation_names_a_bad_rate(estimator, rate, error):
+    with pytest.raises(error, match="rate"):
+        estimator(X[:500], rate=rate)
+
+
+def test_pair_statistics_take_the_rate_of_a_time_index():
+    index = pd.date_range("2026-01-01", periods=1000, freq="10ms")
+    a, b = pd.Series(X[:1000], index=index), pd.Series(X[1000:2000], index=index)
+    assert avar.gcodev(a, b).taus[0] == pytest.approx(0.01)
+    assert avar.three_cornered_hat(a - b, b, -a, data_type="freq").a.taus[0] == pytest.approx(0.01)
 
 
 def test_a_datetime64_seconds_index_with_400_year_steps():
@@ -137,6 +155,13 @@ def test_deviations_of_data_near_the_float64_limits(estimator):
     for scale in (2.0 ** -480, 2.0 ** 480):  # squares under- or overflow; the scaled computation is exact
         got = estimator(X[:512] * scale)
         np.testing.assert_allclose(got.deviation, base.deviation * scale, rtol=1e-12)
+    if estimator.__name__ not in CLASSIC:  # unscaled: tiny data are an error, huge ones overflow clearly
+        if estimator.__name__ != "mtie":
+            with pytest.raises(ValueError, match="data of magnitude .* is below the float64 range"):
+                estimator(X[:512] * 1e-300)
+        with pytest.raises(ValueError, match="overflows float64; rescale the data"):
+            estimator(X[:512] * 1e300)
+        return
     tiny = estimator(X[:512] * 1e-300)  # the deviation is exact; its square rounds to 0 in float64
     np.testing.assert_allclose(tiny.deviation / 1e-300, base.deviation, rtol=1e-12)
     assert np.all(tiny.variance == 0.0) and np.all(tiny.lci <= tiny.deviation)

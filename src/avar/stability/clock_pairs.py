@@ -48,7 +48,7 @@ def _statistic(name: Any):
     return getattr(time_error if name == "pdev" else deviations, name)
 
 
-def three_cornered_hat(ab: Any, bc: Any, ca: Any, rate: float = 1.0, data_type: str = "phase",
+def three_cornered_hat(ab: Any, bc: Any, ca: Any, rate: float | None = None, data_type: str = "phase",
                        taus: Any = "octave", statistic: str = "oadev",
                        confidence: float = DEFAULT_CONFIDENCE) -> ThreeCorneredHat:
     """Separate the deviations of three clocks measured in pairs (the three-cornered hat)::
@@ -124,7 +124,7 @@ def _named_check(data: Any, name: str, data_type: str, nan_policy: str) -> np.nd
         raise type(error)(str(error).replace("data", name, 1)) from None
 
 
-def gcodev(data_1: Any, data_2: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def gcodev(data_1: Any, data_2: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
            confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Groslambert codeviation (the overlapping Allan covariance) of two pair series::
 
@@ -167,7 +167,7 @@ def gcodev(data_1: Any, data_2: Any, rate: float = 1.0, data_type: str = "freq",
     >>> round(float(res.variance[0]), 1)
     1.0
     """
-    rate = check_options("gcodev", rate, data_type, confidence, nan_policy)
+    rate = check_options("gcodev", data_1, rate, data_type, confidence, nan_policy)
     fixed = check_alpha(alpha)
     first, second = (_named_check(data, name, data_type, nan_policy)
                      for data, name in ((data_1, "data_1"), (data_2, "data_2")))

@@ -17,8 +17,8 @@ from avar._kernels.deviation_phase import scan
 from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, rate_from_index, short_repr
 from avar.stability.chi2 import DEFAULT_CONFIDENCE
 
-__all__ = ["DATA_TYPES", "DEFAULT_CONFIDENCE", "NAN_POLICIES", "SCALE_LIMIT", "check_data", "check_options",
-           "rate_of", "scaled"]
+__all__ = ["DATA_TYPES", "DEFAULT_CONFIDENCE", "NAN_POLICIES", "SCALE_LIMIT", "TINY_LIMIT", "check_data", "check_not_tiny",
+           "check_options", "rate_of", "scaled"]
 
 DATA_TYPES = ("freq", "phase")
 NAN_POLICIES = ("raise", "omit")
@@ -66,8 +66,10 @@ def rate_of(data: Any, rate: Any) -> float:
     return 1.0
 
 
-def check_options(estimator: str, rate: Any, data_type: Any, confidence: Any, nan_policy: Any) -> float:
-    """``rate`` back once ``data_type``, ``confidence`` and ``nan_policy`` hold, or an error naming the argument."""
+def check_options(estimator: str, data: Any, rate: Any, data_type: Any, confidence: Any, nan_policy: Any) -> float:
+    """The sampling rate (:func:`rate_of`: ``rate``, else ``data``'s time index, else 1 Hz) once
+    ``rate``, ``data_type``, ``confidence`` and ``nan_policy`` hold, or an error naming the argument."""
+    rate = rate_of(data, rate)
     if not isinstance(data_type, str) or data_type not in DATA_TYPES:
         raise ValueError(f"data_type must be 'freq' (fractional frequency) or 'phase' (time error, s), "
                          f"got {short_repr(data_type)}")
@@ -96,3 +98,22 @@ def scaled(values: np.ndarray, scanned: tuple, weigh: bool) -> tuple[np.ndarray,
     exponent = int(np.frexp(big)[1])
     values = np.ldexp(values, -exponent)
     return values, scan(values, weigh=weigh), exponent
+
+
+#: Data below 2**-TINY_LIMIT in magnitude have variances at the bottom of float64 (about 1e-302 and less).
+TINY_LIMIT = 500
+
+
+def check_not_tiny(statistic: str, scanned: tuple) -> None:
+    """An error for data below 2**-TINY_LIMIT in magnitude (but not all zero), for the statistics
+    that do not rescale them (their variance would underflow to 0: a zero deviation, silently).
+
+    >>> check_not_tiny("mtotdev", (0, 0.0, -1e-300, 1e-300, np.nan))
+    Traceback (most recent call last):
+    ...
+    ValueError: data of magnitude 1e-300 is below the float64 range of mtotdev's variance; rescale the data, e.g. to other units
+    """
+    big = max(abs(float(scanned[2])), abs(float(scanned[3])))
+    if np.isfinite(big) and 0 < big < 2.0 ** -TINY_LIMIT:
+        raise ValueError(f"data of magnitude {big:.3g} is below the float64 range of {statistic}'s variance; "
+                         "rescale the data, e.g. to other units")

@@ -32,7 +32,7 @@ import numpy as np
 from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_core import OctaveMoments, deviation_levels_and_phase
 from avar.stability.deviation_grids import MIN_PHASE_POINTS, deviation_factors, levels_with_terms
-from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_options, rate_of, scaled
+from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_options, scaled
 from avar.stability.deviation_results import Deviation
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.noise_id import NOISE_ID_ESTIMATORS, identify_noise, octave_noise, phase_noise
@@ -115,7 +115,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     if not isinstance(bias_correction, (bool, np.bool_)):
         raise TypeError(f"bias_correction must be True or False, got {bias_correction!r}")
     fixed = check_alpha(alpha)
-    rate = check_options(estimator, rate_of(data, rate), data_type, confidence, nan_policy)
+    rate = check_options(estimator, data, rate, data_type, confidence, nan_policy)
     drift_removed = estimator in ("hdev", "ohdev") and data_type == "freq"  # the scan finds the drift too
     values, scanned = check_data(data, data_type, nan_policy, weigh=drift_removed)
     n_missing = int(scanned[0])

@@ -60,7 +60,7 @@ def _levels(n_phase: int, rate: float, taus: Any, k: float | None) -> tuple[np.n
     return allan, theo
 
 
-def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def theoh(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
           switch: float | None = None) -> Deviation:
     """ThêoH deviation: OADEV at short taus, TheoBR at long ones::
@@ -148,10 +148,14 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
         lambda: theobr_factor(x, autocorr),
         lambda: theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0)[0], autocorr)[0],
         lambda: oavar_sums(x, allan))
-    avar = allan_sums / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit
     counts = n_phase - theo
-    theobr = kf * sums / (0.75 * counts * theo * theo) / scale / scale * unit
+    with np.errstate(over="ignore"):  # an overflow is an error below
+        avar = allan_sums / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit
+        theobr = kf * sums / (0.75 * counts * theo * theo) / scale / scale * unit
     factors = np.concatenate((allan, theo))
+    variance = np.concatenate((avar, theobr))
+    if not np.all(np.isfinite(variance)):
+        raise ValueError("theoh overflows float64; rescale the data, e.g. to other units")
     if alpha is None:
         ident = np.concatenate((allan, np.maximum(1, np.round(0.75 * theo)).astype(np.int64)))
         alphas = noise_exponents("oadev", values, data_type, rate, ident)
@@ -159,9 +163,6 @@ def theoh(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oc
         alphas = np.full(factors.size, alpha, dtype=np.int64)
     edf = np.concatenate((estimator_edf("oadev", alphas[: allan.size], allan, n_phase),
                           total_edf("theo1", alphas[allan.size :], theo, n_phase)))
-    variance = np.concatenate((avar, theobr))
-    if not np.all(np.isfinite(variance)):
-        raise ValueError("theoh overflows float64; rescale the data, e.g. to other units")
     deviation = np.sqrt(variance)
     lci, uci = chi2_bounds(deviation, edf, float(confidence), quantiles=CATALOGUE_QUANTILES)
     return Deviation(taus=np.concatenate((allan, 0.75 * theo)) / rate, averaging_factors=factors, deviation=deviation,

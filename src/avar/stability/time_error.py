@@ -17,7 +17,7 @@ import numpy as np
 from avar._kernels.time_error import mtie_levels, pdev_levels, tierms_levels
 from avar.stability.chi2 import CATALOGUE_QUANTILES
 from avar.stability.deviation_grids import levels_with_terms
-from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_options
+from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_not_tiny, check_options
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import _noise_of_levels, noise_exponents
 from avar.stability.edf import chi2_bounds, estimator_edf, gap_scaled_edf
@@ -56,9 +56,11 @@ def largest_factor(statistic: str, n_phase: int) -> int:
 
 def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, confidence: Any,
               nan_policy: Any, alpha: Any) -> Deviation:
-    rate = check_options(statistic, rate, data_type, confidence, nan_policy)
+    rate = check_options(statistic, data, rate, data_type, confidence, nan_policy)
     fixed = check_alpha(alpha)
     values, scanned = check_data(data, data_type, nan_policy)
+    if statistic != "mtie":  # a range needs no square
+        check_not_tiny(statistic, scanned)
     n_phase = values.size + (data_type == "freq")
     if n_phase < 3:
         raise ValueError(f"data has {values.size} sample(s); {statistic} of {data_type} data needs at least "
@@ -71,7 +73,8 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     if statistic == "mtie":
         # a window with a gap is skipped, so the filled values never reach a result
         deviation, n = mtie_levels(phase, factors, gaps, extra)
-        variance = deviation**2
+        with np.errstate(over="ignore"):  # an overflow is an error below
+            variance = deviation**2
     else:
         if statistic == "pdev":
             phase = _line_free(phase, gaps, extra)
@@ -81,7 +84,7 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         else:
             sums, n = tierms_levels(phase, factors, gaps, extra)
             m, scale = factors.astype(np.float64), 1.0
-        with np.errstate(invalid="ignore", divide="ignore"):
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # overflow: an error below
             variance = sums / (scale * n)
         if statistic == "pdev":
             variance = variance / (m / rate) ** 2
@@ -151,7 +154,7 @@ def _line_free(phase: np.ndarray, gaps: np.ndarray, extra: int) -> np.ndarray:
     return np.ascontiguousarray(phase - intercept - slope * (index - index.mean()))
 
 
-def mtie(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def mtie(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Maximum time interval error, the largest peak-to-peak phase excursion in a window of tau::
 
@@ -178,7 +181,7 @@ def mtie(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "oct
     return _estimate("mtie", data, rate, data_type, taus, confidence, nan_policy, alpha)
 
 
-def tierms(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def tierms(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
            confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Time interval error rms::
 
@@ -202,7 +205,7 @@ def tierms(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "o
     return _estimate("tierms", data, rate, data_type, taus, confidence, nan_policy, alpha)
 
 
-def pdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def pdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
     """Parabolic deviation (the deviation of the Omega counter's least-squares frequency)::
 

@@ -23,7 +23,7 @@ from avar._kernels.total import level_sums, theo1_sum
 from avar.stability.chi2 import CATALOGUE_QUANTILES, chi2_bounds
 from avar.stability.deviation_core import phase_parts
 from avar.stability.deviation_grids import levels_with_terms
-from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_options
+from avar.stability.deviation_inputs import DEFAULT_CONFIDENCE, check_data, check_not_tiny, check_options
 from avar.stability.deviation_results import Deviation
 from avar.stability.deviations import noise_exponents
 from avar.stability.noise_types import ALPHA_PARAMETER, check_alpha
@@ -53,8 +53,9 @@ _PARAMETERS = """
     data : array_like or pandas.Series
         1-D fractional frequency y (``data_type="freq"``) or phase x in
         seconds (``"phase"``); NaN marks a gap (see ``nan_policy``).
-    rate : float
-        Sampling rate in Hz; tau0 = 1 / rate.
+    rate : float, optional
+        Sampling rate in Hz; tau0 = 1 / rate. Default: the rate of the regular
+        time index of a pandas Series, else 1 Hz (as :func:`avar.oadev`).
     data_type : {"freq", "phase"}
     taus : {"octave", "decade", "all"} or array_like of float
         Averaging times (see :func:`avar.stability.total_edf.total_factors`).
@@ -84,8 +85,9 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
     """Validate once: ``values, rate, x, bad, shift, scale, n_phase``; ``x`` the detrended phase
     (scaled by ``scale``, a power of two; HTOTDEV: its linear frequency drift removed too, as
     every statistic here is blind to it) with gaps filled, ``bad`` their prefix count."""
-    rate = check_options(estimator, rate, data_type, confidence, nan_policy)
+    rate = check_options(estimator, data, rate, data_type, confidence, nan_policy)
     values, scanned = check_data(data, data_type, nan_policy)
+    check_not_tiny(estimator, scanned)
     needed = _MIN_PHASE.get(estimator, 3) - (data_type == "freq")
     if values.size < needed:
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
@@ -108,7 +110,7 @@ def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.nd
         sums = np.concatenate((np.zeros(first), sums))
         counts = np.concatenate((np.zeros(first, dtype=counts.dtype), counts))
     m = factors.astype(np.float64)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # overflow: an error below
         if estimator == "htotdev":
             variance = sums / (6.0 * counts)
             if factors.size and factors[0] == 1:  # NIST, Stable32: OHDEV at m = 1
@@ -186,7 +188,7 @@ def correct_bias(estimator: str, variance: np.ndarray, alpha: np.ndarray, factor
     return variance / np.array([MTOT_BIAS[int(a)] for a in alpha])
 
 
-def mtotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def mtotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
             confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
             bias_correction: bool = False) -> Deviation:
     """Modified total deviation, NIST SP 1065 eq. (27)::
@@ -226,7 +228,7 @@ def mtotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     return estimate("mtotdev", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
 
 
-def ttotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def ttotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
             confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
             bias_correction: bool = False) -> Deviation:
     """Time total deviation, NIST SP 1065 eq. (28): sigma_x^2(tau) = tau^2 / 3 Mod Tot var(tau), in seconds.
@@ -247,7 +249,7 @@ def ttotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     return estimate("ttotdev", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
 
 
-def htotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def htotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
             confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
             bias_correction: bool = True) -> Deviation:
     """Hadamard total deviation, NIST SP 1065 eq. (29)::
@@ -285,7 +287,7 @@ def htotdev(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "
     return estimate("htotdev", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
 
 
-def theo1(data: Any, rate: float = 1.0, data_type: str = "freq", taus: Any = "octave",
+def theo1(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
           bias_correction: bool | str | None = None) -> Deviation:
     """Theo1 deviation, NIST SP 1065 eq. (30), at tau = 0.75 m tau0 with m even::
