@@ -242,6 +242,10 @@ def test_grids_and_validation():
     assert total_factors("mtotdev", 100, 1.0, "octave").tolist() == [1, 2, 4, 8, 16, 32]
     with pytest.raises(ValueError, match="m even"):
         avar.theo1(SMALL_Y, taus=[2.25])
+    # the range in Theo1's taus: m = 2 .. 40 (even, N = 41 phase points) is tau = 1.5 .. 30 s
+    with pytest.raises(ValueError, match=r"taus \[0.1, 31.0\] are outside the valid range \[1.5, 30\] s of theo1"):
+        avar.theo1(SMALL_Y, taus=[0.1, 1.5, 31.0])
+    assert avar.theo1(SMALL_Y, taus=[1.5, 30.0]).averaging_factors.tolist() == [2, 40]
     with pytest.raises(ValueError, match="alpha must be in -2 .. 2"):
         avar.mtotdev(SMALL_Y, alpha=3)
     with pytest.raises(TypeError, match="alpha must be None or an integer"):

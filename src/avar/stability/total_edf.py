@@ -111,9 +111,16 @@ def total_factors(estimator: str, n_phase: int, rate: float, taus: Any) -> np.nd
         factors = grid_factors(taus, rate, largest, first_octave=1, context=context)
         return factors[(factors % 2 == 0)]
     try:
-        scaled = np.asarray(taus, dtype=np.float64) / 0.75
+        given = np.asarray(taus, dtype=np.float64)
+        scaled = given / 0.75
     except (TypeError, ValueError):
         scaled = taus  # grid_factors names what is wrong
+    else:  # the range in Theo1's own taus, not in the m they stand for
+        low, high = 1.5 / rate, 0.75 * (largest - largest % 2) / rate
+        outside = np.atleast_1d((given < low * (1 - 1e-9)) | (given > high * (1 + 1e-9)))
+        if given.ndim <= 1 and outside.any():
+            raise ValueError(f"taus {short_repr(np.atleast_1d(given)[outside].tolist())} are outside the valid range "
+                             f"[{low:g}, {high:g}] s {context} (tau = 0.75 m / rate, m even)")
     exact = grid_factors(scaled, rate, largest, first_octave=1, context=f"{context} (tau = 0.75 m / rate, m even)")
     requested = np.atleast_1d(scaled) * rate
     odd = (np.abs(requested - np.round(requested)) > 1e-9 * requested) | (np.round(requested) % 2 == 1)
