@@ -56,6 +56,18 @@ def test_compute_gives_the_library_numbers(series_file, tmp_path):
     assert (tmp_path / "av.png").read_bytes().startswith(PNG_MAGIC)
 
 
+def test_compute_reads_an_npz_archive_with_column_names(tmp_path):
+    data = np.random.default_rng(4).standard_normal((2000, 2))
+    np.savez(tmp_path / "imu.npz", data=data, columns=np.array(["Gyro. X", "Gyro. Y"]))
+    out = tmp_path / "av.csv"
+    result = run("compute", str(tmp_path / "imu.npz"), "--freq", "100", "--output", str(out))
+    assert result.returncode == 0, result.stderr
+    table = pd.read_csv(out)
+    assert sorted(set(table["Channel"])) == ["Gyro. X", "Gyro. Y"]
+    got = table[table["Channel"] == "Gyro. Y"]["AVar"].to_numpy()
+    np.testing.assert_allclose(got, avar.avar(data[:, 1], freq=100.0).allan, rtol=1e-14)
+
+
 def test_compute_one_column_of_whitespace_text(tmp_path):
     x = np.random.default_rng(3).standard_normal(3000)
     np.savetxt(tmp_path / "x.txt", x)

@@ -232,6 +232,35 @@ def test_npy_plain_and_structured(tmp_path):
     np.testing.assert_array_equal(rec["gx"], table["gx"])
 
 
+def test_npz_archives_of_named_columns_or_an_array_and_its_names(tmp_path):
+    t = np.arange(500) * 0.01
+    gx, gy = RNG.standard_normal(500), RNG.standard_normal(500)
+    np.savez(tmp_path / "keys.npz", time=t, gx=gx, gy=gy)  # a column per key; time times them
+    rec = read(tmp_path / "keys.npz")
+    assert rec.names == ("gx", "gy") and rec.freq == pytest.approx(100.0, rel=1e-12)
+    np.testing.assert_array_equal(rec["gy"], gy)
+    names = np.array(["Gyro. X", "Gyro. Y", "Gyro. Z", "Accel. X", "Accel. Y", "Accel. Z"])
+    data = RNG.standard_normal((400, 6))
+    np.savez_compressed(tmp_path / "named.npz", data=data, columns=names)  # as the ADIS16405 logs come
+    rec = read(tmp_path / "named.npz", freq=100.0)
+    assert rec.names == tuple(names) and rec.freq == 100.0
+    np.testing.assert_array_equal(rec["Accel. Z"], data[:, 5])
+    np.savez(tmp_path / "plain.npz", np.ones((50, 2)))  # one unnamed array: as .npy
+    assert read(tmp_path / "plain.npz").names == ("x1", "x2")
+    for name, arrays, message in [
+        ("two.npz", dict(a=np.ones((9, 2)), b=np.ones((9, 2))), r"holds a float64\[9, 2\], b float64\[9, 2\]"),
+        ("ragged.npz", dict(a=np.ones(9), b=np.ones(8)), r"equal-length 1-D arrays"),
+        ("badnames.npz", dict(data=np.ones((9, 2)), columns=np.array(["x"])), r"1 column name\(s\) \['x'\] for 2"),
+        ("objects.npz", dict(data=np.array([{"a": 1}], dtype=object)), r"not a readable .npz archive"),
+    ]:
+        np.savez(tmp_path / name, **arrays)
+        with pytest.raises(InputFileError, match=message):
+            read(tmp_path / name)
+    (tmp_path / "broken.npz").write_bytes(b"PK\x03\x04 not a zip")
+    with pytest.raises(InputFileError, match=r"broken.npz: not a readable .npz archive"):
+        read(tmp_path / "broken.npz")
+
+
 def test_imu_from_named_columns(tmp_path):
     n = 400
     data = RNG.standard_normal((n, 6))

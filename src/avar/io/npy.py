@@ -1,12 +1,18 @@
-"""NumPy ``.npy`` files: plain 1-D or 2-D arrays, or structured arrays with named fields.
+"""NumPy files: ``.npy`` arrays and ``.npz`` archives.
 
-The file is memory-mapped (no copy is made until a column is used). A 1-D array is one
+``.npy``: memory-mapped (no copy is made until a column is used). A 1-D array is one
 column ``x``; a 2-D array of shape (N, C) has columns ``x1 .. xC``; a structured array's
 field names are its column names (so a field ``time`` is a time column).
+
+``.npz`` (``numpy.savez``): either equal-length 1-D arrays, one column each named by its
+key (``savez(f, time=t, gx=gx, ...)``), or one numeric array read as a ``.npy`` array is,
+with at most one array of strings that names its C columns (``savez(f, data=a,
+columns=names)``). Anything else is an error that lists what the archive holds.
 """
 
 from __future__ import annotations
 
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +29,11 @@ def read_npy(path: Path) -> dict[str, np.ndarray]:
     if size > expected:
         raise ValueError(f"{path}: {size - expected} byte(s) follow the {array.shape} array of the .npy file "
                          "(a damaged or concatenated file); save one array per file (numpy.save)")
+    return columns_of_array(array, path)
+
+
+def columns_of_array(array: np.ndarray, path: Path, names: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """The columns of one array as :func:`read_npy` names them, or by ``names`` (one per column)."""
     if array.dtype.names:
         if array.ndim != 1:
             raise ValueError(f"{path}: a structured .npy array must be 1-D, got shape {array.shape}")
@@ -32,6 +43,13 @@ def read_npy(path: Path) -> dict[str, np.ndarray]:
             if field.ndim != 1:
                 raise ValueError(f"{path}: field {name!r} has shape {field.shape[1:]} per row; give one number per field")
             columns[name] = field
+    elif array.ndim in (1, 2) and names is not None:
+        width = 1 if array.ndim == 1 else array.shape[1]
+        labels = [str(name) for name in np.atleast_1d(names)]
+        if len(labels) != width or len(set(labels)) != width:
+            raise ValueError(f"{path}: {len(labels)} column name(s) {labels[:8]} for {width} column(s) of the "
+                             f"{array.shape} array (one distinct name per column)")
+        columns = {label: (array if array.ndim == 1 else array[:, i]) for i, label in enumerate(labels)}
     elif array.ndim == 1:
         columns = {"x": array}
     elif array.ndim == 2:
@@ -44,3 +62,29 @@ def read_npy(path: Path) -> dict[str, np.ndarray]:
         if values.dtype.kind not in "iufM":
             raise ValueError(f"{path}: column {name!r} has dtype {values.dtype}, not numbers")
     return columns
+
+
+def read_npz(path: Path) -> dict[str, np.ndarray]:
+    """The columns of a ``.npz`` archive (see the module's notes), by name."""
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            arrays = {key: archive[key] for key in archive.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+        raise ValueError(f"{path}: not a readable .npz archive ({error})") from None
+    held = ", ".join(f"{key} {value.dtype}{list(value.shape)}" for key, value in arrays.items())
+    if not arrays:
+        raise ValueError(f"{path}: the .npz archive holds no array")
+    text = {key: value for key, value in arrays.items() if value.dtype.kind in "US"}
+    numbers = {key: value for key, value in arrays.items() if key not in text}
+    lengths = {value.shape[0] if value.ndim else None for value in numbers.values()}
+    if len(text) == 0 and len(numbers) > 1 and all(value.ndim == 1 for value in numbers.values()) \
+            and len(lengths) == 1:
+        columns = {}
+        for key, value in numbers.items():
+            columns.update(columns_of_array(value, path, names=np.array([key])))
+        return columns
+    if len(numbers) == 1 and len(text) <= 1:
+        (array,) = numbers.values()
+        return columns_of_array(array, path, names=next(iter(text.values()), None))
+    raise ValueError(f"{path}: a .npz archive must hold equal-length 1-D arrays (a column each, named by its "
+                     f"key) or one array with at most one array of its column names; it holds {held}")

@@ -13,7 +13,7 @@ import pandas as pd
 
 from avar._validation import MIN_SAMPLES, check_freq
 from avar.imu import IMU
-from avar.io.npy import read_npy
+from avar.io.npy import read_npy, read_npz
 from avar.io.progress import CountingReader, progress_enabled
 from avar.io.text import Layout, clip, numeric_column, read_columns
 from avar.io.timecols import rate_of, time_columns
@@ -121,14 +121,16 @@ def read(
     topic: str | None = None,
     progress: bool | None = None,
 ) -> Recording | IMU:
-    """Read a log: a text table, a ``.npy`` array, or a ROS bag.
+    """Read a log: a text table, a ``.npy`` array or ``.npz`` archive, or a ROS bag.
 
     Parameters
     ----------
     path : str or Path
         CSV / TSV / semicolon-separated (decimal commas) / whitespace-separated text,
         with or without a header row (a ``# time gx gy`` comment line is a header);
-        ``.npy`` (plain or structured); a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
+        ``.npy`` (plain or structured); ``.npz`` (equal-length 1-D arrays named by
+        their keys, or one array and the names of its columns; see
+        :mod:`avar.io.npy`); a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
         bag (see :func:`avar.io.bags.read_bag`; needs ``allanvar[ros]``).
     columns : str or list of str, optional
         Data columns to keep (default: all but the time columns). A time column is
@@ -200,9 +202,9 @@ def read(
             raise InputFileError(f"{source}: not a readable ROS bag ({clip(str(error))})") from None
     if topic is not None:
         raise ValueError(f"topic applies to ROS bags ({', '.join(BAG_SUFFIXES)}); {source} is not one")
-    if source.suffix.lower() == ".npy":
+    if source.suffix.lower() in (".npy", ".npz"):
         try:
-            table, layout = read_npy(source), None
+            table, layout = (read_npy if source.suffix.lower() == ".npy" else read_npz)(source), None
         except ValueError as error:
             raise InputFileError(str(error)) from None
     else:
