@@ -261,6 +261,23 @@ def test_npz_archives_of_named_columns_or_an_array_and_its_names(tmp_path):
         read(tmp_path / "broken.npz")
 
 
+@pytest.mark.parametrize("suffix", [".gz", ".bz2", ".xz"])
+@pytest.mark.parametrize("progress", [False, True])
+def test_compressed_text_reads_as_its_text(tmp_path, suffix, progress):
+    frame = pd.DataFrame({"time": np.arange(3000) / 100.0, "gx": RNG.standard_normal(3000),
+                          "gy": np.arange(3000) * 7})
+    frame.to_csv(tmp_path / "log.csv", index=False)
+    frame.to_csv(tmp_path / f"log.csv{suffix}", index=False)  # pandas compresses by the suffix
+    plain, packed = read(tmp_path / "log.csv"), read(tmp_path / f"log.csv{suffix}", progress=progress)
+    assert packed.names == plain.names == ("gx", "gy") and packed.freq == plain.freq
+    np.testing.assert_array_equal(packed["gx"], plain["gx"])
+    assert packed["gy"].dtype == np.int64
+    whole = (tmp_path / f"log.csv{suffix}").read_bytes()
+    (tmp_path / f"cut.csv{suffix}").write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(InputFileError, match=r"cut.csv.*: a damaged (gzip|bz2|lzma) file"):
+        read(tmp_path / f"cut.csv{suffix}", progress=progress)
+
+
 def test_imu_from_named_columns(tmp_path):
     n = 400
     data = RNG.standard_normal((n, 6))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import lzma
 import os
 import sys
 from collections.abc import Sequence
@@ -15,7 +16,7 @@ from avar._validation import MIN_SAMPLES, check_freq
 from avar.imu import IMU
 from avar.io.npy import read_npy, read_npz
 from avar.io.progress import CountingReader, progress_enabled
-from avar.io.text import Layout, clip, numeric_column, read_columns
+from avar.io.text import Layout, clip, compression_of, numeric_column, open_bytes, read_columns
 from avar.io.timecols import rate_of, time_columns
 from avar.recording import Recording
 
@@ -54,8 +55,9 @@ def _text_columns(path: Path, progress: bool | None) -> tuple[dict[str, Any], La
         from tqdm import tqdm
 
         with path.open("rb") as raw, tqdm(total=size, desc=f"reading {path.name}", unit="B", unit_scale=True,
-                                          file=sys.stderr, leave=False) as bar:
-            table, layout = read_columns(path, stream=CountingReader(raw, bar))
+                                          file=sys.stderr, leave=False) as bar, \
+                open_bytes(path, CountingReader(raw, bar)) as stream:  # counts the file's (compressed) bytes
+            table, layout = read_columns(path, stream=stream)
     return table, layout
 
 
@@ -215,6 +217,11 @@ def read(
         except ValueError as error:
             text = str(error) if len(str(error)) <= 400 else f"{str(error)[:400]}... (message cut)"
             raise InputFileError(text if text.startswith(str(source)) else f"{source}: {text}") from None
+        except (EOFError, OSError, lzma.LZMAError) as error:  # the decompressor's: truncated or corrupt
+            module = compression_of(source)
+            if module is None:
+                raise
+            raise InputFileError(f"{source}: a damaged {module.__name__} file ({clip(str(error))})") from None
     names = list(table)
     times = time_columns(names)
     if time_column is not None:

@@ -8,7 +8,9 @@ numbers are parsed by pandas' C engine in one pass, never cell by cell in Python
   the data with one name per column (``# time gx gy``, as ``numpy.savetxt`` writes);
   without one, columns are ``x`` (one column) or ``x1, x2, ...``;
 * decimal commas (``0,5``) when the separator is not a comma;
-* a trailing separator on every line adds no column.
+* a trailing separator on every line adds no column;
+* a gzip, bzip2 or xz compressed file (``log.csv.gz``) is read as its text, found by its
+  first bytes, decompressed as it streams (never whole in memory).
 
 Integer columns stay int64, exact even beyond 2**53. Cells that are not numbers are
 reported with their row and line (clipped to a readable length).
@@ -16,12 +18,18 @@ reported with their row and line (clipped to a readable length).
 
 from __future__ import annotations
 
+import bz2
 import codecs
+import contextlib
 import csv
+import gzip
 import io
+import lzma
 import re
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 import pandas as pd
@@ -76,10 +84,31 @@ def _is_number(token: str) -> bool:
     return bool(_NUMBER.fullmatch(token.strip().strip('"')))
 
 
+#: First bytes of the compressed files read as their text.
+_COMPRESSED = ((b"\x1f\x8b", gzip), (b"BZh", bz2), (b"\xfd7zXZ\x00", lzma))
+
+
+def compression_of(path: Path):
+    """The module (gzip, bz2, lzma) that decompresses ``path``, by its first bytes, else None."""
+    with path.open("rb") as handle:
+        magic = handle.read(6)
+    return next((module for prefix, module in _COMPRESSED if magic.startswith(prefix)), None)
+
+
+@contextlib.contextmanager
+def open_bytes(path: Path, raw: BinaryIO | None = None) -> Iterator[BinaryIO]:
+    """The bytes of ``path`` (or of ``raw``, its opened file), decompressed if it is compressed."""
+    module = compression_of(path)
+    with contextlib.ExitStack() as stack:
+        if raw is None:
+            raw = stack.enter_context(path.open("rb"))
+        yield raw if module is None else stack.enter_context(module.open(raw, "rb"))
+
+
 def detect_encoding(path: Path) -> str:
     """The text encoding of ``path``: from its byte-order mark, or UTF-16/32 recognised without one
     by the zero bytes of ASCII text; else UTF-8 (a UTF-8 byte-order mark skipped)."""
-    with path.open("rb") as handle:
+    with open_bytes(path) as handle:
         head = handle.read(4096)
     if head.startswith((codecs.BOM_UTF32_LE, codecs.BOM_UTF32_BE)):
         return "utf-32"
@@ -98,7 +127,8 @@ def detect_encoding(path: Path) -> str:
         if zeros[0] + zeros[2] == 2 * quarter and zeros[1] + zeros[3] < 2 * quarter:
             return "utf-16-be"
         raise ValueError(f"{path}: not a text table (binary data: {head.count(0)} zero bytes in the first "
-                         f"{len(head)}); give a CSV/text file in UTF-8, UTF-16 or UTF-32, or a .npy array")
+                         f"{len(head)}); give a CSV/text file in UTF-8, UTF-16 or UTF-32 (gzip/bzip2/xz compressed or not), or a "
+                         ".npy/.npz array")
     return "utf-8-sig"
 
 
@@ -107,7 +137,7 @@ def _head(path: Path, encoding: str) -> list[str]:
     length (a 10,000-column header is read whole), then more up to :data:`SNIFF_BYTES`."""
     lines: list[str] = []
     total = content = 0
-    with path.open("r", encoding=encoding, errors="replace", newline="") as handle:
+    with open_bytes(path) as raw, io.TextIOWrapper(raw, encoding=encoding, errors="replace", newline="") as handle:
         while line := handle.readline(MAX_LINE_CHARS + 1):
             if len(line) > MAX_LINE_CHARS and not line.endswith(("\n", "\r")):
                 raise ValueError(f"{path}: line {len(lines) + 1} is longer than {MAX_LINE_CHARS:,} characters; "
@@ -182,7 +212,7 @@ _COUNT_BLOCK = 1 << 24
 def count_lines(path: Path) -> int:
     """Newlines in the file (an upper bound of its rows, less one)."""
     count = 0
-    with path.open("rb") as handle:
+    with open_bytes(path) as handle:
         while block := handle.read(_COUNT_BLOCK):
             count += block.count(b"\n")
     return count
@@ -261,8 +291,8 @@ class _Columns:
 def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[dict[str, np.ndarray], Layout]:
     """The table's columns as arrays (numbers where they parse, else text), and its layout.
 
-    ``stream`` (the opened file, e.g. wrapped by a progress bar) is read instead of
-    ``path`` when given.
+    ``stream`` (the opened file's bytes, decompressed, e.g. counted by a progress bar) is
+    read instead of ``path`` when given.
     """
     layout = sniff(path, detect_encoding(path))
     names = _check_names(layout.names, path)
@@ -273,7 +303,9 @@ def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[d
             # A column whose blocks parse to different types is object here; numeric_column then
             # parses it or names its first non-number, so pandas' DtypeWarning would only be noise.
             warnings.simplefilter("ignore", pd.errors.DtypeWarning)
-            _read_chunks(stream if stream is not None else path, layout, names, extra, columns, path)
+            with contextlib.ExitStack() as stack:
+                source = stream if stream is not None else stack.enter_context(open_bytes(path))
+                _read_chunks(source, layout, names, extra, columns, path)
     except pd.errors.EmptyDataError:
         raise ValueError(f"{path}: the file holds a header but no data") from None
     except pd.errors.ParserWarning:
