@@ -278,6 +278,25 @@ def test_compressed_text_reads_as_its_text(tmp_path, suffix, progress):
         read(tmp_path / f"cut.csv{suffix}", progress=progress)
 
 
+def test_parquet_tables_by_their_magic_bytes(tmp_path):
+    pytest.importorskip("pyarrow")
+    times = pd.date_range("2026-01-01", periods=2000, freq="5ms", tz="Europe/Paris")
+    frame = pd.DataFrame({"time": times, "gx": RNG.standard_normal(2000), "count": np.arange(2000)})
+    frame.to_parquet(tmp_path / "imu.parquet")
+    frame.to_parquet(tmp_path / "imu.dat")  # found by its first bytes, not its name
+    for name in ("imu.parquet", "imu.dat"):
+        rec = read(tmp_path / name)
+        assert rec.names == ("gx", "count") and rec.freq == pytest.approx(200.0, rel=1e-12)
+        np.testing.assert_array_equal(rec["gx"], frame["gx"].to_numpy())
+        assert rec["count"].dtype == np.int64
+    frame.assign(label="a").to_parquet(tmp_path / "text.parquet")
+    with pytest.raises(InputFileError, match=r"column 'label' has dtype .*, not numbers or times"):
+        read(tmp_path / "text.parquet")
+    (tmp_path / "cut.parquet").write_bytes((tmp_path / "imu.parquet").read_bytes()[:300])
+    with pytest.raises(InputFileError, match=r"cut.parquet: not a readable Parquet file"):
+        read(tmp_path / "cut.parquet")
+
+
 def test_imu_from_named_columns(tmp_path):
     n = 400
     data = RNG.standard_normal((n, 6))

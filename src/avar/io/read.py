@@ -15,6 +15,7 @@ import pandas as pd
 from avar._validation import MIN_SAMPLES, check_freq
 from avar.imu import IMU
 from avar.io.npy import read_npy, read_npz
+from avar.io.parquet import is_parquet, read_parquet
 from avar.io.progress import CountingReader, progress_enabled
 from avar.io.text import Layout, clip, compression_of, numeric_column, open_bytes, read_columns
 from avar.io.timecols import rate_of, time_columns
@@ -123,7 +124,7 @@ def read(
     topic: str | None = None,
     progress: bool | None = None,
 ) -> Recording | IMU:
-    """Read a log: a text table, a ``.npy`` array or ``.npz`` archive, or a ROS bag.
+    """Read a log: a text table, a ``.npy`` array or ``.npz`` archive, a Parquet table, or a ROS bag.
 
     Parameters
     ----------
@@ -132,7 +133,7 @@ def read(
         with or without a header row (a ``# time gx gy`` comment line is a header);
         ``.npy`` (plain or structured); ``.npz`` (equal-length 1-D arrays named by
         their keys, or one array and the names of its columns; see
-        :mod:`avar.io.npy`); a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
+        :mod:`avar.io.npy`); Parquet (needs pyarrow); a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
         bag (see :func:`avar.io.bags.read_bag`; needs ``allanvar[ros]``).
     columns : str or list of str, optional
         Data columns to keep (default: all but the time columns). A time column is
@@ -204,9 +205,10 @@ def read(
             raise InputFileError(f"{source}: not a readable ROS bag ({clip(str(error))})") from None
     if topic is not None:
         raise ValueError(f"topic applies to ROS bags ({', '.join(BAG_SUFFIXES)}); {source} is not one")
-    if source.suffix.lower() in (".npy", ".npz"):
+    if source.suffix.lower() in (".npy", ".npz") or is_parquet(source):
+        reader = {".npy": read_npy, ".npz": read_npz}.get(source.suffix.lower(), read_parquet)
         try:
-            table, layout = (read_npy if source.suffix.lower() == ".npy" else read_npz)(source), None
+            table, layout = reader(source), None
         except ValueError as error:
             raise InputFileError(str(error)) from None
     else:
