@@ -245,10 +245,14 @@ def test_npz_archives_of_named_columns_or_an_array_and_its_names(tmp_path):
     rec = read(tmp_path / "named.npz", freq=100.0)
     assert rec.names == tuple(names) and rec.freq == 100.0
     np.testing.assert_array_equal(rec["Accel. Z"], data[:, 5])
+    np.savez(tmp_path / "timed.npz", time=np.arange(400) / 50.0, data=data, columns=names)  # a time beside
+    rec = read(tmp_path / "timed.npz")
+    assert rec.names == tuple(names) and rec.freq == pytest.approx(50.0, rel=1e-12)
     np.savez(tmp_path / "plain.npz", np.ones((50, 2)))  # one unnamed array: as .npy
     assert read(tmp_path / "plain.npz").names == ("x1", "x2")
     for name, arrays, message in [
         ("two.npz", dict(a=np.ones((9, 2)), b=np.ones((9, 2))), r"holds a float64\[9, 2\], b float64\[9, 2\]"),
+        ("rows.npz", dict(t=np.ones(8), data=np.ones((9, 2))), r"holds t float64\[8\], data float64\[9, 2\]"),
         ("ragged.npz", dict(a=np.ones(9), b=np.ones(8)), r"equal-length 1-D arrays"),
         ("badnames.npz", dict(data=np.ones((9, 2)), columns=np.array(["x"])), r"1 column name\(s\) \['x'\] for 2"),
         ("objects.npz", dict(data=np.array([{"a": 1}], dtype=object)), r"not a readable .npz archive"),

@@ -4,9 +4,9 @@
 column ``x``; a 2-D array of shape (N, C) has columns ``x1 .. xC``; a structured array's
 field names are its column names (so a field ``time`` is a time column).
 
-``.npz`` (``numpy.savez``): either equal-length 1-D arrays, one column each named by its
-key (``savez(f, time=t, gx=gx, ...)``), or one numeric array read as a ``.npy`` array is,
-with at most one array of strings that names its C columns (``savez(f, data=a,
+``.npz`` (``numpy.savez``): equal-length 1-D arrays, one column each named by its key
+(``savez(f, time=t, gx=gx, ...)``), and at most one other array read as a ``.npy`` array
+is, whose C columns at most one array of strings names (``savez(f, time=t, data=a,
 columns=names)``). Anything else is an error that lists what the archive holds.
 """
 
@@ -76,15 +76,27 @@ def read_npz(path: Path) -> dict[str, np.ndarray]:
         raise ValueError(f"{path}: the .npz archive holds no array")
     text = {key: value for key, value in arrays.items() if value.dtype.kind in "US"}
     numbers = {key: value for key, value in arrays.items() if key not in text}
-    lengths = {value.shape[0] if value.ndim else None for value in numbers.values()}
-    if len(text) == 0 and len(numbers) > 1 and all(value.ndim == 1 for value in numbers.values()) \
-            and len(lengths) == 1:
-        columns = {}
-        for key, value in numbers.items():
-            columns.update(columns_of_array(value, path, names=np.array([key])))
-        return columns
-    if len(numbers) == 1 and len(text) <= 1:
-        (array,) = numbers.values()
-        return columns_of_array(array, path, names=next(iter(text.values()), None))
-    raise ValueError(f"{path}: a .npz archive must hold equal-length 1-D arrays (a column each, named by its "
-                     f"key) or one array with at most one array of its column names; it holds {held}")
+    tables = [key for key, value in numbers.items() if value.ndim != 1 or value.dtype.names]
+    if len(numbers) == 1:  # one array, named by the one array of strings if there is one
+        main = next(iter(numbers))
+    elif len(tables) == 1:  # one table, and 1-D arrays beside it (a time, say)
+        main = tables[0]
+    else:  # 1-D arrays only: a column each
+        main = None
+    singles = {key: value for key, value in numbers.items() if key != main}
+    rows = {value.shape[0] for value in singles.values() if value.ndim == 1}
+    if main is not None and numbers[main].ndim >= 1:
+        rows.add(numbers[main].shape[0])
+    if len(text) > 1 or (text and main is None) or any(value.ndim != 1 for value in singles.values()) \
+            or len(rows) > 1:
+        raise ValueError(f"{path}: a .npz archive must hold equal-length 1-D arrays (a column each, named by its "
+                         f"key) and at most one other array (its columns named by at most one array of strings) "
+                         f"of as many rows; it holds {held}")
+    columns = {}
+    if main is not None:
+        columns.update(columns_of_array(numbers[main], path, names=next(iter(text.values()), None)))
+    for key, value in singles.items():
+        if key in columns:
+            raise ValueError(f"{path}: the column name {key!r} is both a key and a name of {main!r}'s columns")
+        columns.update(columns_of_array(value, path, names=np.array([key])))
+    return columns
