@@ -131,9 +131,10 @@ def read(
     path : str or Path
         CSV / TSV / semicolon-separated (decimal commas) / whitespace-separated text,
         with or without a header row (a ``# time gx gy`` comment line is a header);
-        ``.npy`` (plain or structured); ``.npz`` (equal-length 1-D arrays named by
-        their keys, or one array and the names of its columns; see
-        :mod:`avar.io.npy`); Parquet (needs pyarrow); a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
+        gzip/bzip2/xz compressed or not; ``.npy`` (plain or structured); ``.npz``
+        (equal-length 1-D arrays named by their keys beside at most one array and
+        the names of its columns; see :mod:`avar.io.npy`); Parquet (needs pyarrow,
+        see :mod:`avar.io.parquet`); a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
         bag (see :func:`avar.io.bags.read_bag`; needs ``allanvar[ros]``).
     columns : str or list of str, optional
         Data columns to keep (default: all but the time columns). A time column is
