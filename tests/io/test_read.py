@@ -301,6 +301,26 @@ def test_parquet_tables_by_their_magic_bytes(tmp_path):
         read(tmp_path / "cut.parquet")
 
 
+def test_matlab_files_of_vectors_or_a_named_matrix(tmp_path):
+    from scipy.io import savemat
+
+    t, data = np.arange(600) / 50.0, RNG.standard_normal((600, 3))
+    savemat(tmp_path / "named.mat", {"time": t.reshape(-1, 1), "data": data,
+                                     "names": np.array(["gx", "gy", "gz"], dtype=object)})  # a cell array
+    rec = read(tmp_path / "named.mat")
+    assert rec.names == ("gx", "gy", "gz") and rec.freq == pytest.approx(50.0, rel=1e-12)
+    np.testing.assert_array_equal(rec["gz"], data[:, 2])
+    savemat(tmp_path / "vectors.mat", {"time": t, "ax": data[:, 0]})  # 1 x N row vectors
+    rec = read(tmp_path / "vectors.mat")
+    assert rec.names == ("ax",) and rec.freq == pytest.approx(50.0, rel=1e-12)
+    savemat(tmp_path / "struct.mat", {"log": {"gx": data[:, 0]}})
+    with pytest.raises(InputFileError, match=r"variable\(s\) \['log'\] are cell arrays or structs"):
+        read(tmp_path / "struct.mat")
+    (tmp_path / "cut.mat").write_bytes((tmp_path / "named.mat").read_bytes()[:200])
+    with pytest.raises(InputFileError, match=r"cut.mat: not a readable MATLAB file"):
+        read(tmp_path / "cut.mat")
+
+
 def test_imu_from_named_columns(tmp_path):
     n = 400
     data = RNG.standard_normal((n, 6))

@@ -130,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
 
 def add_input_arguments(parser: argparse.ArgumentParser, many: bool = False) -> None:
     """The reading and output options; ``many``: one or more files (``avar compute``)."""
-    what = "CSV/TSV/text, .npy/.npz, Parquet, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros]); see docs/reading.md"
+    what = "CSV/TSV/text, .npy/.npz, Parquet, .mat, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros]); see docs/reading.md"
     if many:
         parser.add_argument("file", nargs="+",
                             help=f"{what}; several files give one table with a File column")

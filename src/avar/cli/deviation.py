@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
 def add_parser(commands) -> None:
     parser = commands.add_parser(
         "deviation", help="Stable32-style tables of ADEV, OADEV, MDEV, ... of one column of phase or frequency data")
-    parser.add_argument("file", help="CSV/TSV/text, .npy/.npz or Parquet file of phase or frequency data")
+    parser.add_argument("file", help="CSV/TSV/text, .npy/.npz, Parquet or .mat file of phase or frequency data")
     parser.add_argument("--stat", action="append", metavar="NAME", choices=DEVIATION_STATISTICS,
                         help=f"statistic (repeatable; default oadev): {', '.join(DEVIATION_STATISTICS)}")
     parser.add_argument("--data-type", choices=["phase", "freq"], required=True,

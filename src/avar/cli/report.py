@@ -106,7 +106,7 @@ def add_parser(commands) -> None:
     report = commands.add_parser(
         "report", help="IMU noise report: ARW, bias instability, RRW (IEEE 952), Kalibr imu.yaml, figure"
     )
-    report.add_argument("file", help="CSV/TSV/text, .npy/.npz, Parquet, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros])")
+    report.add_argument("file", help="CSV/TSV/text, .npy/.npz, Parquet, .mat, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros])")
     report.add_argument("--topic", help="sensor_msgs/Imu topic of a ROS bag (default: its only one); "
                         "written as Kalibr's rostopic")
     report.add_argument("--gyro", action="extend", nargs="+", metavar="NAME",

@@ -71,9 +71,14 @@ def read_npz(path: Path) -> dict[str, np.ndarray]:
             arrays = {key: archive[key] for key in archive.files}
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
         raise ValueError(f"{path}: not a readable .npz archive ({error})") from None
+    return columns_of_arrays(arrays, path, "a .npz archive")
+
+
+def columns_of_arrays(arrays: dict[str, np.ndarray], path: Path, what: str) -> dict[str, np.ndarray]:
+    """The columns of named arrays (an archive's, a MATLAB file's), by the rules of ``.npz``."""
     held = ", ".join(f"{key} {value.dtype}{list(value.shape)}" for key, value in arrays.items())
     if not arrays:
-        raise ValueError(f"{path}: the .npz archive holds no array")
+        raise ValueError(f"{path}: {what} that holds no array")
     text = {key: value for key, value in arrays.items() if value.dtype.kind in "US"}
     numbers = {key: value for key, value in arrays.items() if key not in text}
     tables = [key for key, value in numbers.items() if value.ndim != 1 or value.dtype.names]
@@ -89,7 +94,7 @@ def read_npz(path: Path) -> dict[str, np.ndarray]:
         rows.add(numbers[main].shape[0])
     if len(text) > 1 or (text and main is None) or any(value.ndim != 1 for value in singles.values()) \
             or len(rows) > 1:
-        raise ValueError(f"{path}: a .npz archive must hold equal-length 1-D arrays (a column each, named by its "
+        raise ValueError(f"{path}: {what} must hold equal-length 1-D arrays (a column each, named by its "
                          f"key) and at most one other array (its columns named by at most one array of strings) "
                          f"of as many rows; it holds {held}")
     columns = {}

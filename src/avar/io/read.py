@@ -14,6 +14,7 @@ import pandas as pd
 
 from avar._validation import MIN_SAMPLES, check_freq
 from avar.imu import IMU
+from avar.io.matlab import read_mat
 from avar.io.npy import read_npy, read_npz
 from avar.io.parquet import is_parquet, read_parquet
 from avar.io.progress import CountingReader, progress_enabled
@@ -124,7 +125,7 @@ def read(
     topic: str | None = None,
     progress: bool | None = None,
 ) -> Recording | IMU:
-    """Read a log: a text table, a ``.npy`` array or ``.npz`` archive, a Parquet table, or a ROS bag.
+    """Read a log: a text table, a ``.npy`` array or ``.npz`` archive, a Parquet table, a MATLAB file, or a ROS bag.
 
     Parameters
     ----------
@@ -134,7 +135,8 @@ def read(
         gzip/bzip2/xz compressed or not; ``.npy`` (plain or structured); ``.npz``
         (equal-length 1-D arrays named by their keys beside at most one array and
         the names of its columns; see :mod:`avar.io.npy`); Parquet (needs pyarrow,
-        see :mod:`avar.io.parquet`); a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
+        see :mod:`avar.io.parquet`); MATLAB ``.mat`` v4-v7 (:mod:`avar.io.matlab`);
+        a ROS 1 ``.bag`` or ROS 2 ``.db3``/``.mcap``
         bag (see :func:`avar.io.bags.read_bag`; needs ``allanvar[ros]``).
     columns : str or list of str, optional
         Data columns to keep (default: all but the time columns). A time column is
@@ -206,8 +208,8 @@ def read(
             raise InputFileError(f"{source}: not a readable ROS bag ({clip(str(error))})") from None
     if topic is not None:
         raise ValueError(f"topic applies to ROS bags ({', '.join(BAG_SUFFIXES)}); {source} is not one")
-    if source.suffix.lower() in (".npy", ".npz") or is_parquet(source):
-        reader = {".npy": read_npy, ".npz": read_npz}.get(source.suffix.lower(), read_parquet)
+    if source.suffix.lower() in (".npy", ".npz", ".mat") or is_parquet(source):
+        reader = {".npy": read_npy, ".npz": read_npz, ".mat": read_mat}.get(source.suffix.lower(), read_parquet)
         try:
             table, layout = reader(source), None
         except ValueError as error:
