@@ -265,6 +265,14 @@ def test_npz_archives_of_named_columns_or_an_array_and_its_names(tmp_path):
         read(tmp_path / "broken.npz")
 
 
+def refuses_a_cut_copy(path, size: int, message: str, **options) -> None:
+    """The first ``size`` bytes of ``path`` as ``cut<suffixes>``: an error naming that file."""
+    cut = path.with_name("cut" + "".join(path.suffixes))
+    cut.write_bytes(path.read_bytes()[:size])
+    with pytest.raises(InputFileError, match=rf"{cut.name}: {message}"):
+        read(cut, **options)
+
+
 @pytest.mark.parametrize("suffix", [".gz", ".bz2", ".xz"])
 @pytest.mark.parametrize("progress", [False, True])
 def test_compressed_text_reads_as_its_text(tmp_path, suffix, progress):
@@ -276,10 +284,8 @@ def test_compressed_text_reads_as_its_text(tmp_path, suffix, progress):
     assert packed.names == plain.names == ("gx", "gy") and packed.freq == plain.freq
     np.testing.assert_array_equal(packed["gx"], plain["gx"])
     assert packed["gy"].dtype == np.int64
-    whole = (tmp_path / f"log.csv{suffix}").read_bytes()
-    (tmp_path / f"cut.csv{suffix}").write_bytes(whole[: len(whole) // 2])
-    with pytest.raises(InputFileError, match=r"cut.csv.*: a damaged (gzip|bz2|lzma) file"):
-        read(tmp_path / f"cut.csv{suffix}", progress=progress)
+    whole = (tmp_path / f"log.csv{suffix}").stat().st_size
+    refuses_a_cut_copy(tmp_path / f"log.csv{suffix}", whole // 2, r"a damaged (gzip|bz2|lzma) file", progress=progress)
 
 
 def test_parquet_tables_by_their_magic_bytes(tmp_path):
@@ -296,9 +302,7 @@ def test_parquet_tables_by_their_magic_bytes(tmp_path):
     frame.assign(label="a").to_parquet(tmp_path / "text.parquet")
     with pytest.raises(InputFileError, match=r"column 'label' has dtype .*, not numbers or times"):
         read(tmp_path / "text.parquet")
-    (tmp_path / "cut.parquet").write_bytes((tmp_path / "imu.parquet").read_bytes()[:300])
-    with pytest.raises(InputFileError, match=r"cut.parquet: not a readable Parquet file"):
-        read(tmp_path / "cut.parquet")
+    refuses_a_cut_copy(tmp_path / "imu.parquet", 300, r"not a readable Parquet file")
 
 
 def test_matlab_files_of_vectors_or_a_named_matrix(tmp_path):
@@ -316,9 +320,7 @@ def test_matlab_files_of_vectors_or_a_named_matrix(tmp_path):
     savemat(tmp_path / "struct.mat", {"log": {"gx": data[:, 0]}})
     with pytest.raises(InputFileError, match=r"variable\(s\) \['log'\] are cell arrays or structs"):
         read(tmp_path / "struct.mat")
-    (tmp_path / "cut.mat").write_bytes((tmp_path / "named.mat").read_bytes()[:200])
-    with pytest.raises(InputFileError, match=r"cut.mat: not a readable MATLAB file"):
-        read(tmp_path / "cut.mat")
+    refuses_a_cut_copy(tmp_path / "named.mat", 200, r"not a readable MATLAB file")
 
 
 def test_imu_from_named_columns(tmp_path):
