@@ -35,6 +35,9 @@ def read_npy(path: Path) -> dict[str, np.ndarray]:
 def columns_of_array(array: np.ndarray, path: Path, names: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """The columns of one array as :func:`read_npy` names them, or by ``names`` (one per column)."""
     if array.dtype.names:
+        if names is not None:  # the fields name the columns: other names would be dropped unseen
+            raise ValueError(f"{path}: the structured array names its own columns {list(array.dtype.names)[:8]}; "
+                             f"drop the array of names {[str(name) for name in np.atleast_1d(names)][:8]}")
         if array.ndim != 1:
             raise ValueError(f"{path}: a structured .npy array must be 1-D, got shape {array.shape}")
         columns = {}
