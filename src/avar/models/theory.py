@@ -245,7 +245,8 @@ def av_dr(delta: Any, n: Any) -> float | np.ndarray:
     m = _as_whole(n, "n")
     _broadcast(d, m, names=("delta", "n"))
     mf = m.astype(np.float64)
-    return _finish(mf * mf * d * d / 2.0, d, m)
+    drift = mf * d  # n delta, then one rounding into the result: no double rounding among subnormals
+    return _finish(drift * (drift / 2.0), d, m)
 
 
 def av_ar1(n: Any, phi: Any, sigma2: Any) -> float | np.ndarray:
