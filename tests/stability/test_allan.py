@@ -9,6 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 from reference import allan_mo_loop, allan_to_loop, exact_allan
+from scipy.stats import norm
 
 import avar
 from avar.stability.grids import averaging_factors
@@ -272,8 +273,9 @@ def test_chi2_band_is_chi2_bounds_of_the_edf(type, estimator):
     phase = np.concatenate(([0.0], np.cumsum(x - x.mean()))) / 50.0
     alpha = identify_noise(phase, res.averaging_factors, estimator)
     edf = estimator_edf(estimator, alpha, res.averaging_factors, 4097)
-    lci, uci = chi2_bounds(res.adev, edf, 0.683)
-    assert res.ci == "chi2" and res.confidence == 0.683
+    one_sigma = 2 * norm.cdf(1.0) - 1  # the default: one standard deviation of a normal variable
+    lci, uci = chi2_bounds(res.adev, edf, one_sigma)
+    assert res.ci == "chi2" and res.confidence == one_sigma
     np.testing.assert_array_equal(res.alpha, alpha)
     np.testing.assert_array_equal(res.edf, edf)
     np.testing.assert_array_equal(res.lci, lci)
@@ -302,7 +304,7 @@ def test_chi2_band_values_white_fm_non_overlapping():
     assert estimator_edf("adev", [0], [1024], 4097)[0] == pytest.approx(18 / 8, rel=1e-12)
     assert res.edf[0] == estimator_edf("adev", res.alpha, [1024], 4097)[0]
 
-    q = (1 - 0.683) / 2
+    q = norm.cdf(-1.0)  # one sigma, two-sided
     assert res.lci[0] == pytest.approx(res.adev[0] * np.sqrt(res.edf[0] / chi2.isf(q, res.edf[0])), rel=1e-14)
 
 

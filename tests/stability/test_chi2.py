@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from scipy.special import ndtri
-from scipy.stats import chi2
+from scipy.stats import chi2, norm
 
 import avar
 from avar.stability.chi2 import chi2_bounds
@@ -77,26 +77,42 @@ STABLE32_TABLES = {
 }
 
 
-def _errors(name, quantiles):
+def _errors(name, quantiles, confidence):
     n_phase, rows = STABLE32_TABLES[name]
     rows = np.array(rows)
     factors, alpha, low, sigma, high = rows[:, 0].astype(int), rows[:, 1].astype(int), rows[:, 2], rows[:, 3], rows[:, 4]
     edf = estimator_edf(name.split()[1] if " " in name else "oadev", alpha, factors, n_phase)
-    lci, uci = chi2_bounds(sigma, edf, 0.683, quantiles=quantiles)
+    lci, uci = chi2_bounds(sigma, edf, confidence, quantiles=quantiles)
     return edf, np.maximum(np.abs(lci / low - 1), np.abs(uci / high - 1))
+
+
+ONE_SIGMA = 2 * norm.cdf(1.0) - 1  # 0.682689..., printed by Stable32 as "Confidence Factor = 0.683"
 
 
 @pytest.mark.parametrize("name", sorted(STABLE32_TABLES))
 def test_stable32_quantiles_print_stable32s_bounds(name):
-    edf, error = _errors(name, "stable32")
+    edf, error = _errors(name, "stable32", ONE_SIGMA)
     large = edf > 100
     # Above 100 EDF: Stable32's own approximation, equal to its 5 printed digits (half a unit
-    # of the 5th digit is at most 5e-5 of the value; one row of gps is 7.3e-5 off)
-    assert error[large].max() < 8e-5 and np.median(error[large]) < 3e-5
-    # Below: Stable32 iterates to the exact quantile, to about 4 digits; Greenhall's EDF is the same
-    assert error.max() < 2.5e-4
+    # of the 5th digit is at most 5e-5 of the value)
+    assert error[large].max() < 7e-5 and np.median(error[large]) < 2e-5
+    # Below: Stable32 iterates to the exact quantile, to about 4 digits (its upper bound at the
+    # fewest degrees of freedom, 5 to 9, is 1e-4 to 2.5e-4 above the exact one); Greenhall's EDF is the same
+    assert error.max() < 2.6e-4
     # The exact quantiles miss the printed bounds where the EDF is large: the test can fail
-    assert _errors(name, "exact")[1][large].max() > 1.4e-4
+    assert _errors(name, "exact", ONE_SIGMA)[1][large].max() > 1e-4
+
+
+def test_stable32_computes_with_one_sigma_not_the_printed_0683():
+    # Its tables print "Confidence Factor = 0.683", but 0.683 misses their bounds by up to twice as
+    # much, one-sided (intervals 0.1 % wider in EDF): the confidence it computes with is erf(1/sqrt(2))
+    def errors(confidence):
+        return np.concatenate([_errors(name, "stable32", confidence)[1] for name in STABLE32_TABLES])
+
+    exact_sigma, printed = errors(ONE_SIGMA), errors(0.683)
+    assert np.median(exact_sigma) < 2e-5 < np.median(printed)
+    assert np.mean(exact_sigma < printed) > 0.7
+    assert avar.oadev(np.arange(100.0) % 7, taus=[1.0]).confidence == ONE_SIGMA
 
 
 def test_wilson_hilferty_with_stable32s_normal_quantile():
@@ -138,7 +154,8 @@ def test_the_catalogue_prints_stable32s_bounds_and_the_allan_band_stays_exact():
     np.testing.assert_array_equal(res.lci, chi2_bounds(res.deviation, res.edf, res.confidence, quantiles="stable32")[0])
     assert res.lci[0] != chi2_bounds(res.deviation, res.edf, res.confidence)[0][0]
     band = avar.avar(y, freq=1.0, type="mo", ci="chi2")
-    lci, _ = chi2_bounds(np.sqrt(band.allan), band.edf, 0.683)
+    lci, _ = chi2_bounds(np.sqrt(band.allan), band.edf, band.confidence)
+    assert band.confidence == res.confidence == 2 * norm.cdf(1.0) - 1  # one sigma, both
     np.testing.assert_array_equal(band.chi2_lci, lci)
 
 

@@ -305,7 +305,7 @@ def test_a_fixed_alpha_sets_every_levels_edf_and_bounds(estimator):
         np.testing.assert_array_equal(fixed.deviation, free.deviation)
         edf = estimator_edf(estimator, fixed.alpha, fixed.averaging_factors, y.size + 1)
         np.testing.assert_allclose(fixed.edf, edf, rtol=1e-14)
-        lci, uci = chi2_bounds(fixed.deviation, edf, 0.683, quantiles=CATALOGUE_QUANTILES)
+        lci, uci = chi2_bounds(fixed.deviation, edf, fixed.confidence, quantiles=CATALOGUE_QUANTILES)
         np.testing.assert_allclose(fixed.lci, lci, rtol=1e-14)
         np.testing.assert_allclose(fixed.uci, uci, rtol=1e-14)
 

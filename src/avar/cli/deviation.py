@@ -15,6 +15,7 @@ import pandas as pd
 
 from avar.cli.common import Progress, UsageError
 from avar.cli.outputs import plan_outputs, report
+from avar.stability.chi2 import DEFAULT_CONFIDENCE
 from avar.stability.statistics import DEVIATION_STATISTICS
 
 #: Columns of the printed table, as Stable32's run table.
@@ -102,7 +103,8 @@ def add_parser(commands) -> None:
     parser.add_argument("--rate", type=float, help="sampling rate in Hz (default: from a time column, else 1)")
     parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help="tau grid")
     parser.add_argument("--column", metavar="NAME", help="the data column (needed when there are several)")
-    parser.add_argument("--confidence", type=float, default=0.683, help="confidence of Min/Max Sigma (0.683)")
+    parser.add_argument("--confidence", type=float, default=DEFAULT_CONFIDENCE,
+                        help="confidence of Min/Max Sigma (default one sigma, 0.6827, printed 0.683 as Stable32)")
     parser.add_argument("--noise", type=int, choices=[2, 1, 0, -1, -2], metavar="ALPHA",
                         help="fix the noise exponent alpha at every level, as Stable32 allows (2 white PM, "
                              "1 flicker PM, 0 white FM, -1 flicker FM, -2 random-walk FM); default: identified")

@@ -10,6 +10,7 @@ from matplotlib.axes import Axes
 from matplotlib.colors import is_color_like
 from matplotlib.figure import Figure, FigureBase
 
+from avar.stability.chi2 import format_confidence
 from avar.stability.results import AllanVariance
 
 #: Colour of the empirical curve (R ``avar``: "darkblue").
@@ -144,7 +145,7 @@ def band_label(av: AllanVariance, name: str) -> str:
     >>> band_label(avar.avar(x), "AD"), band_label(avar.avar(x, ci="chi2"), "AV")
     ('CI(AD, 0.95)', 'chi2 CI(AV, 0.683)')
     """
-    return f"chi2 CI({name}, {av.confidence:g})" if av.ci == "chi2" else f"CI({name}, 0.95)"
+    return f"chi2 CI({name}, {format_confidence(av.confidence)})" if av.ci == "chi2" else f"CI({name}, 0.95)"
 
 
 def axis_labels(units: str | None, deviation: bool, xlab: str | None, ylab: str | None) -> tuple[str, str]:

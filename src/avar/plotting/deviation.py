@@ -22,6 +22,7 @@ from avar.plotting.base import (
     new_axes,
     setup_log_axes,
 )
+from avar.stability.chi2 import format_confidence
 from avar.stability.deviation_results import Deviation
 
 
@@ -97,7 +98,7 @@ def plot_deviation(
             above = x.uci[valid] - x.deviation[valid]
             ax.errorbar(x.taus[valid], x.deviation[valid], yerr=np.vstack([below, above]), fmt="none",
                         ecolor=colour, elinewidth=1.0, capsize=3, zorder=2,
-                        label=f"{x.confidence:.3g} confidence (chi-squared)")
+                        label=f"{format_confidence(x.confidence)} confidence (chi-squared)")
             drawn += [x.lci[valid], x.uci[valid]]
     if ylab is None:
         ylab = f"{x.name} $\\sigma_x(\\tau)$ (s)" if x.estimator in ("tdev", "ttotdev") else f"{x.name} $\\sigma_y(\\tau)$"

@@ -78,7 +78,8 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
         (type "mo") or ADEV (type "to") (:mod:`avar.stability.edf`). The
         result then also carries ``alpha``, ``edf`` and ``confidence``.
     confidence : float, optional
-        Confidence level of the ``"chi2"`` band, in (0, 1); default 0.683 (Stable32).
+        Confidence level of the ``"chi2"`` band, in (0, 1); default one sigma
+        (0.6827, Stable32's 0.683).
     nan_policy : {"raise", "omit"}
         NaN in a series: an error (default), or gaps whose differences are
         skipped: every difference of cluster means that touches a NaN is left

@@ -36,8 +36,13 @@ import numpy as np
 
 from avar._validation import short_repr
 
-#: Stable32's default confidence factor (about one standard deviation).
-DEFAULT_CONFIDENCE = 0.683
+#: One standard deviation, erf(1 / sqrt(2)) = 0.682689...: the default confidence. Stable32 prints
+#: it as "Confidence Factor = 0.683" and computes with the exact value: its printed bounds are
+#: reproduced with this, not with 0.683, whose intervals are as wide as one sigma's with 0.15 % fewer
+#: degrees of freedom
+#: (``tests/stability/test_chi2.py``).
+ONE_SIGMA = 0.6826894921370859
+DEFAULT_CONFIDENCE = ONE_SIGMA
 QUANTILES = ("exact", "stable32")
 #: The quantiles of the deviation catalogue's bounds: Stable32's, to print what it prints.
 CATALOGUE_QUANTILES = "stable32"
@@ -68,7 +73,8 @@ def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE
         Equivalent degrees of freedom, > 0 (NaN gives NaN bounds); broadcast
         against ``deviation``.
     confidence : float
-        Two-sided confidence level in (0, 1); default 0.683 as Stable32.
+        Two-sided confidence level in (0, 1); default one sigma, 0.6827 (what
+        Stable32 prints as 0.683).
     quantiles : {"exact", "stable32"}
         The chi-squared quantiles: exact, or Stable32's (exact up to 100
         degrees of freedom, Wilson–Hilferty above; see the module's notes).
@@ -82,8 +88,8 @@ def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE
     >>> lci, uci = chi2_bounds(0.2, 999.0)
     >>> round(float(lci), 5), round(float(uci), 5)
     (0.19567, 0.20463)
-    >>> [round(float(b), 5) for b in chi2_bounds(0.2, 999.0, quantiles="stable32")]
-    [0.19569, 0.20461]
+    >>> [round(float(b), 6) for b in chi2_bounds(0.2, 999.0, quantiles="stable32")]
+    [0.195696, 0.204603]
     >>> [b.round(3).tolist() for b in chi2_bounds([1.0, 1.0], [1.0, 10.0], confidence=0.95)]
     [[0.446, 0.699], [31.91, 1.755]]
     >>> [b.round(3).tolist() for b in chi2_bounds([1.0], [1.0], confidence=0.1)]  # lci widened to the estimate
@@ -134,3 +140,12 @@ def _real_array(values: Any, name: str) -> np.ndarray:
     if array.dtype.kind not in "iuf" or isinstance(values, (bool, np.bool_)):
         raise TypeError(f"{name} must be a real number or array, got {short_repr(values)}")
     return array.astype(np.float64)
+
+
+def format_confidence(confidence: float) -> str:
+    """A confidence level as printed: one sigma as Stable32 prints it (0.683), any other as given.
+
+    >>> format_confidence(ONE_SIGMA), format_confidence(0.95), format_confidence(0.9973)
+    ('0.683', '0.95', '0.9973')
+    """
+    return "0.683" if confidence == ONE_SIGMA else f"{confidence:g}"

@@ -13,6 +13,7 @@ import pandas as pd
 
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
+from avar.stability.chi2 import format_confidence
 from avar.stability.deviation_grids import ESTIMATORS as _FAMILY
 from avar.stability.deviation_grids import LONG_NAMES as _FAMILY_NAMES
 from avar.stability.statistics import DEVIATION_STATISTICS, EXTRA_LONG_NAMES, PAIR_STATISTICS
@@ -144,7 +145,7 @@ class Deviation:
         """One line: estimator, input, rate, levels and confidence."""
         return (
             f"{self.name} ({self.long_name}) of {self.n_samples} {self.data_type} samples "
-            f"at {self.rate:g} Hz, {len(self)} levels, {self.confidence:.3g} confidence"
+            f"at {self.rate:g} Hz, {len(self)} levels, {format_confidence(self.confidence)} confidence"
         )
 
     def __str__(self) -> str:

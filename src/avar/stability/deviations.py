@@ -58,7 +58,8 @@ _PARAMETERS = """
         explicit taus in seconds (rounded to whole m; one outside the valid
         range raises ``ValueError`` naming it).
     confidence : float
-        Two-sided confidence level of ``lci``/``uci`` in (0, 1); 0.683 (1 sigma) as Stable32.
+        Two-sided confidence level of ``lci``/``uci`` in (0, 1); one sigma (0.6827,
+        printed 0.683 as Stable32) by default.
     nan_policy : {"raise", "omit"}
         ``"raise"``: NaN raises ``ValueError`` naming its index; ``"omit"``:
         terms touching a NaN are skipped and ``n`` counts the terms used.

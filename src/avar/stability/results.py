@@ -19,6 +19,7 @@ if TYPE_CHECKING:  # pandas loads with the first table
 
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
+from avar.stability.chi2 import format_confidence
 
 TYPE_NAMES = {"mo": "maximal overlap", "to": "tau overlap"}
 SUMMARY_COLUMNS = ["Time", "AVar", "ADev", "Lower CI", "Upper CI"]
@@ -176,7 +177,7 @@ class AllanVariance:
         return (
             f"{label}Allan variance ({TYPE_NAMES.get(self.type, self.type)}, type {self.type!r}), "
             f"N = {self.n}, freq = {format_frequency(self.freq)}, {len(self)} levels"
-            + (f", chi-squared {self.confidence:g} band" if self.ci == "chi2" else "")
+            + (f", chi-squared {format_confidence(self.confidence)} band" if self.ci == "chi2" else "")
         )
 
     def __str__(self) -> str:

@@ -2,7 +2,7 @@
 
 Every name in :data:`DEVIATION_STATISTICS` is a public function of ``avar``
 with the signature ``(data, rate=None, data_type="freq", taus="octave",
-confidence=0.683, nan_policy="raise", alpha=None, ...)`` returning a
+confidence=ONE_SIGMA (0.6827), nan_policy="raise", alpha=None, ...)`` returning a
 :class:`avar.Deviation`; the command line (``avar deviation --stat NAME``)
 looks them up here and calls ``getattr(avar, name)``. A new statistic is one
 line in each table.

@@ -60,7 +60,8 @@ _PARAMETERS = """
     taus : {"octave", "decade", "all"} or array_like of float
         Averaging times (see :func:`avar.stability.total_edf.total_factors`).
     confidence : float
-        Two-sided confidence level of ``lci``/``uci`` in (0, 1); 0.683 as Stable32.
+        Two-sided confidence level of ``lci``/``uci`` in (0, 1); one sigma (0.6827,
+        Stable32's 0.683) by default.
     nan_policy : {"raise", "omit"}
         ``"omit"``: every term (window) touching a gap is skipped; ``n`` counts
         the terms used and the EDF is scaled by the fraction used.
