@@ -5,16 +5,15 @@ phase noise (Kasdin and Walter, exact spectrum, ``avar.models.noise.power_law``)
 of N = 1001 points, the size of Stable32's PHASE.DAT, this script estimates it per
 level and prints it next to:
 
-* ``avar``: what avar uses (:func:`avar.stability.total_edf.total_edf`: for MTOTVAR
-  from m = 10 Stable32's law at white FM and flicker PM, NIST SP 1065 Table 8 at the
-  other noises, the modified Allan variance's Greenhall EDF below m = 10; HTOTVAR's
-  (N / m) / (b0 + b1 m / N) from m = 16, NIST SP 1065 Table 5's simple EDF below and at PM);
-* ``nist``: NIST SP 1065 Table 8 for MTOTVAR from m = 10 (b N / m - c);
-* ``stable32``: the EDF that Stable32 1.60's printed bounds imply, where its tables
-  of PHASE.DAT show it (alpha = 0 and 1; from its bounds with its own chi-squared
-  quantiles, :mod:`avar.stability.chi2`). For MTOTVAR from m = 10 they follow
-  4/3 (N - 1) / m - 1.89 (white FM) and 1.734 (N - 1) / m - 2.99 (flicker PM),
-  a law of no published table, which its tables of a second record (N = 1253) obey too.
+* ``avar``: what avar uses (:func:`avar.stability.total_edf.total_edf`), which is
+  Stable32 1.60's: its printed one-sigma bounds of PHASE.DAT and of a 1253-point
+  clock record are reproduced to 1e-4 (``tests/stability/test_total_theo.py``). For
+  MTOTVAR from m = 10 that is b (N - 1) / m - c, (b, c) = (1.3313, 1.8927) at white
+  FM, (1.7319, 2.9896) at flicker PM, (0.9204, 0.7596) at flicker FM, a law of no
+  published table; NIST SP 1065 Table 8 at the other noises, the modified Allan
+  variance's Greenhall EDF below m = 10. HTOTVAR: (N / m) / (b0 + b1 m / N) from
+  m = 16, NIST SP 1065 Table 5's simple EDF plus 2 below and at PM;
+* ``nist``: NIST SP 1065 Table 8 for MTOTVAR from m = 10 (b N / m - c).
 
 The standard error of a simulated EDF comes from 200 bootstrap resamples of the R
 estimates. A formula is right where it lies within a few standard errors.
@@ -22,14 +21,14 @@ estimates. A formula is right where it lies within a few standard errors.
 Run: ``python benchmarks/total_edf_simulation.py [--records 2000]`` (about 1 min per
 1,000 records on 2 cores). Measured (2,000 records, seed 0 .. 1999), white FM:
 
-====  ===========  ======  ========
-m     simulation   nist    stable32
-====  ===========  ======  ========
-16    64.2         67.6    81.5
-32    32.9         33.2    39.8
+====  ===========  ======  ==================
+m     simulation   nist    avar (= Stable32)
+====  ===========  ======  ==================
+16    64.2         67.6    81.3
+32    32.9         33.2    39.7
 64    14.7         16.0    18.9
 128   6.2          7.4     8.5
-====  ===========  ======  ========
+====  ===========  ======  ==================
 
 so Stable32's MTOTDEV intervals at m >= 10 are those of 20 to 40 % more degrees of
 freedom than the estimates have (flicker PM: 50 % at m = 128). avar prints Stable32's
@@ -48,13 +47,6 @@ from avar.models.noise import power_law
 from avar.stability.total_edf import MTOT_EDF, MTOT_EDF_FROM, total_edf
 
 N_PHASE = 1001
-#: EDF implied by Stable32 1.60's printed bounds of PHASE.DAT (chi2 quantiles as Stable32).
-STABLE32_IMPLIED = {
-    ("mtotdev", 0): {10: 131.4, 16: 81.45, 20: 64.8, 32: 39.78, 40: 31.43, 64: 18.94, 128: 8.53, 256: 3.32},
-    ("mtotdev", 1): {100: 14.35, 128: 10.56, 200: 5.68, 256: 3.79},
-    ("htotdev", 0): {1: 668.8, 2: 572.2, 4: 348.5, 8: 184.4, 16: 108.9, 32: 52.98, 64: 25.13},
-    ("htotdev", 1): {128: 50.68, 256: 18.58},
-}
 LEVELS = {"mtotdev": [1, 4, 10, 16, 32, 64, 128, 256], "htotdev": [2, 4, 8, 16, 32, 64, 128, 256]}
 
 
@@ -85,14 +77,12 @@ def main() -> None:
         factors = LEVELS[estimator]
         edf, error = simulated_edf(estimator, alpha, args.records, factors)
         ours = total_edf(estimator, np.full(len(factors), alpha), np.array(factors), N_PHASE)
-        implied = STABLE32_IMPLIED.get((estimator, alpha), {})
         print(f"\n{estimator}, alpha = {alpha}, N = {N_PHASE}, {args.records} records")
-        print(f"{'m':>5} {'simulated':>10} {'+/-':>6} {'avar':>8} {'nist':>8} {'stable32':>9}")
+        print(f"{'m':>5} {'simulated':>10} {'+/-':>6} {'avar':>8} {'nist':>8}")
         for m, e, s, o in zip(factors, edf, error, ours):
-            s32 = f"{implied[m]:9.2f}" if m in implied else f"{'':>9}"
             b, c = MTOT_EDF[alpha]
             nist = f"{b * N_PHASE / m - c:8.2f}" if estimator == "mtotdev" and m >= MTOT_EDF_FROM else f"{'':>8}"
-            print(f"{m:5d} {e:10.2f} {s:6.2f} {o:8.2f} {nist} {s32}")
+            print(f"{m:5d} {e:10.2f} {s:6.2f} {o:8.2f} {nist}")
 
 
 if __name__ == "__main__":

@@ -204,13 +204,13 @@ def test_theobr_factor_follows_its_definition():
 
 def test_edf_and_bias_formulas():
     np.testing.assert_allclose(total_edf("mtotdev", np.array([2, 1, 0, -1, -2]), np.full(5, 10), 1001),
-                               [1.9 * 100.1 - 2.1, 1.734 * 100 - 2.99, 4 / 3 * 100 - 1.89, 0.85 * 100.1 - 0.5,
-                                0.75 * 100.1 - 0.31])  # Stable32's law at white FM and flicker PM, else Table 8
+                               [1.9 * 100.1 - 2.1, 1.7319 * 100 - 2.9896, 1.3313 * 100 - 1.8927, 0.9204 * 100 - 0.7596,
+                                0.75 * 100.1 - 0.31])  # Stable32's law at white FM, flicker PM and FM, else Table 8
     r, n = 75.0, 1001.0
     assert total_edf("theo1", np.array([0]), np.array([100]), 1001)[0] == pytest.approx(
         ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * r**1.5 / (r**1.5 + 5.2))
     assert total_edf("htotdev", np.array([-1]), np.array([32]), 1001)[0] == pytest.approx((n / 32) / (0.868 + 1.14 * 32 / n))
-    assert total_edf("htotdev", np.array([-1]), np.array([8]), 1001)[0] == pytest.approx(5 * 1001**2 / (32 * 1025))
+    assert total_edf("htotdev", np.array([-1]), np.array([8]), 1001)[0] == pytest.approx(5 * 1001**2 / (32 * 1025) + 2)
     y = np.random.default_rng(5).standard_normal(500)
     raw = avar.htotdev(y, taus=[4.0], alpha=-1, bias_correction=False)
     fixed = avar.htotdev(y, taus=[4.0], alpha=-1)
@@ -263,26 +263,42 @@ def test_grids_and_validation():
     assert "time total deviation" in str(res) and len(res.summary()) == len(res)
 
 
-# Stable32 on its PHASE.DAT (N = 1001 phase points), confidence 0.683: AF, #, alpha, min, sigma, max.
+# Stable32 on its PHASE.DAT (N = 1001 phase points), confidence printed 0.683 (one sigma): AF, #,
+# alpha, min, sigma, max.
 STABLE32_HTOTDEV = [(1, 998, 0, 2.8670e-01, 2.9439e-01, 3.0274e-01), (2, 995, 0, 1.9726e-01, 2.0297e-01, 2.0922e-01),
                     (4, 989, 0, 1.3744e-01, 1.4252e-01, 1.4821e-01), (8, 977, 0, 1.0303e-01, 1.0822e-01, 1.1430e-01),
                     (16, 953, 0, 6.1280e-02, 6.5265e-02, 7.0151e-02), (32, 905, 0, 4.0870e-02, 4.4644e-02, 4.9703e-02),
-                    (64, 809, 0, 2.9694e-02, 3.3576e-02, 3.9530e-02), (128, 617, 1, 2.6309e-02, 2.8790e-02, 3.2137e-02)]
+                    (64, 809, 0, 2.9694e-02, 3.3576e-02, 3.9530e-02), (128, 617, 1, 2.6309e-02, 2.8790e-02, 3.2137e-02),
+                    (256, 233, 1, 1.2846e-02, 1.4773e-02, 1.7946e-02)]
+# The same of the 1253-point clock record (allantoolkit's tests/assets/Sr87/phase/{octave,decade}/htotdev.txt):
+# white, flicker and random-walk FM below m = 16, flicker PM at 100.
+STABLE32_HTOTDEV_SR87 = [(1, 1250, -1, 8.0946e-17, 8.2651e-17, 8.4469e-17), (2, 1247, -2, 7.5923e-17, 7.8025e-17, 8.0313e-17),
+                         (4, 1241, -1, 8.8264e-17, 9.1349e-17, 9.4785e-17), (8, 1229, 0, 8.5090e-17, 8.8938e-17, 9.3364e-17),
+                         (10, 1223, 0, 8.1805e-17, 8.5915e-17, 9.0718e-17), (16, 1205, 0, 7.8591e-17, 8.3165e-17, 8.8649e-17),
+                         (64, 1061, 0, 4.8613e-17, 5.4288e-17, 6.2567e-17), (100, 953, 1, 4.4525e-17, 4.7680e-17, 5.1617e-17),
+                         (256, 485, 0, 1.8034e-17, 2.2308e-17, 3.2500e-17), (400, 53, -1, 1.1419e-17, 1.5213e-17, 3.1436e-17)]
 STABLE32_COUNTS = {"mtotdev": {1: 999, 2: 996, 16: 954, 256: 234}, "htotdev": {1: 998, 2: 995, 128: 617, 256: 233},
                    "theo1": {10: 4955, 100: 45050, 998: 1497}}  # Thêo1 #, printed 4.9550e+03 ...
 
 
-def test_stable32_htotdev_bounds_and_term_counts():
-    from avar.stability.edf import chi2_bounds
+@pytest.mark.parametrize("n_phase, table", [(1001, STABLE32_HTOTDEV), (1253, STABLE32_HTOTDEV_SR87)])
+def test_stable32_htotdev_bounds_and_term_counts(n_phase, table):
+    from avar.stability.edf import chi2_bounds, simple_edf
     from avar.stability.total_edf import term_counts
 
-    rows = np.array(STABLE32_HTOTDEV)
-    edf = total_edf("htotdev", rows[:, 2].astype(int), rows[:, 0].astype(int), 1001)
-    lci, uci = chi2_bounds(rows[:, 4], edf, 0.683, quantiles="stable32")
-    # m >= 16: Stable32 prints 5 digits (exact quantiles: 4.6e-4); below, NIST SP 1065 Table 5's EDF,
-    # which Stable32's bounds follow to 4e-4 (Greenhall's overlapping Hadamard EDF: 7e-3); flicker PM 3e-3
-    tolerance = np.where(rows[:, 2] == 1, 3e-3, np.where(rows[:, 0] >= 16, 1.2e-4, 4e-4))
-    assert np.all(np.abs(lci / rows[:, 3] - 1) < tolerance) and np.all(np.abs(uci / rows[:, 5] - 1) < tolerance)
+    rows = np.array(table)
+    factors, alpha = rows[:, 0].astype(int), rows[:, 2].astype(int)
+    edf = total_edf("htotdev", alpha, factors, n_phase)
+    lci, uci = chi2_bounds(rows[:, 4], edf, quantiles="stable32")  # one sigma
+    # 5 printed digits: 8.6e-5 at most (m = 400, 2.5 EDF). Below m = 16 and at PM that takes NIST SP
+    # 1065 Table 5's EDF plus 2 (at flicker PM: 18.54 degrees of freedom at m = 256, where Stable32's
+    # bounds imply 18.55)
+    np.testing.assert_allclose(lci, rows[:, 3], rtol=1e-4)
+    np.testing.assert_allclose(uci, rows[:, 5], rtol=1e-4)
+    table_5 = (factors < 16) | (alpha > 0)
+    bare = chi2_bounds(rows[:, 4], np.where(table_5, simple_edf(n_phase, factors, alpha), edf), quantiles="stable32")
+    assert np.max(np.abs(bare[1] / rows[:, 5] - 1)[table_5]) > 9e-4  # Table 5 alone misses them
+    assert term_counts("htotdev", n_phase, factors).tolist() == rows[:, 1].astype(int).tolist()
     for name, counts in STABLE32_COUNTS.items():
         assert term_counts(name, 1001, np.array(list(counts))).tolist() == list(counts.values())
     # Stable32's HTOTDEV of PHASE.DAT with and without its bias removal at m = 2 (alpha = 0):
@@ -319,9 +335,12 @@ STABLE32_MTOTDEV_LONG = [(10, 0, 5.2415e-02, 5.5529e-02, 5.9277e-02), (16, 0, 3.
 
 
 # Stable32 1.60 of a clock's phase record of N = 1253 points (BIPM Sr87, tau0 = 2.5 s; allantoolkit's
-# tests/assets/Sr87/phase/decade/mtotdev.txt), m >= 10: AF, alpha, min, sigma, max.
+# tests/assets/Sr87/{phase,freq}/decade/mtotdev.txt), m >= 10: AF, alpha, min, sigma, max.
 STABLE32_MTOTDEV_SR87 = [(10, 0, 6.3861e-17, 6.7260e-17, 7.1270e-17), (20, 0, 5.3546e-17, 5.7573e-17, 6.2669e-17),
-                         (40, 0, 3.9907e-17, 4.4121e-17, 5.0032e-17), (100, 1, 2.5070e-17, 2.8818e-17, 3.4977e-17)]
+                         (40, 0, 3.9907e-17, 4.4121e-17, 5.0032e-17), (100, 1, 2.5070e-17, 2.8818e-17, 3.4977e-17),
+                         (200, -1, 1.1921e-17, 1.5037e-17, 2.3447e-17), (400, -1, 1.2033e-17, 1.6256e-17, 3.7550e-17)]
+STABLE32_MTOTDEV_SR87_FREQ_DECADE = [(200, -1, 1.1920e-17, 1.5037e-17, 2.3453e-17),
+                                     (400, -1, 1.2032e-17, 1.6256e-17, 3.7578e-17)]
 
 
 # The same record's octave tables as 1253 phase and as 1252 frequency points (m = 64 .. 256): their
@@ -334,25 +353,29 @@ STABLE32_MTOTDEV_SR87_FREQ = [(64, 0, 3.2782e-17, 3.7146e-17, 4.3897e-17), (128,
 
 @pytest.mark.parametrize("n_phase, n_given, table", [(1001, 1001, STABLE32_MTOTDEV_LONG), (1253, 1253, STABLE32_MTOTDEV_SR87),
                                                      (1253, 1253, STABLE32_MTOTDEV_SR87_PHASE),
-                                                     (1253, 1252, STABLE32_MTOTDEV_SR87_FREQ)])
+                                                     (1253, 1252, STABLE32_MTOTDEV_SR87_FREQ),
+                                                     (1253, 1252, STABLE32_MTOTDEV_SR87_FREQ_DECADE)])
 def test_mtotdev_bounds_from_m_10_are_stable32s(n_phase, n_given, table):
-    # From m = 10 Stable32's bounds follow 4/3 (N - 1) / m - 1.89 degrees of freedom (white FM) and
-    # 1.734 (N - 1) / m - 2.99 (flicker PM) on records of two lengths; NIST SP 1065's Table 8 gives
-    # 10 to 45 % fewer, and simulated records fewer still (benchmarks/total_edf_simulation.py).
+    # From m = 10 Stable32's bounds follow b (N - 1) / m - c degrees of freedom, (b, c) = (1.3313,
+    # 1.8927) at white FM, (1.7319, 2.9896) at flicker PM, (0.9204, 0.7596) at flicker FM, on records
+    # of two lengths; NIST SP 1065's Table 8 gives 10 to 45 % fewer at the first two, and simulated
+    # records fewer still (benchmarks/total_edf_simulation.py).
     from avar.stability.edf import chi2_bounds
 
     rows = np.array(table)
     factors, alpha = rows[:, 0].astype(int), rows[:, 1].astype(int)
     edf = total_edf("mtotdev", alpha, factors, n_phase, n_given=n_given)
-    lci, uci = chi2_bounds(rows[:, 3], edf, 0.683, quantiles="stable32")
-    np.testing.assert_allclose(lci, rows[:, 2], rtol=6.5e-4)  # EDF 3 at m = 256: 5 digits of a wide bound
-    np.testing.assert_allclose(uci, rows[:, 4], rtol=6.5e-4)
-    if n_given != n_phase:  # with the phase count the frequency table's m = 256 bound misses by 9.7e-4
-        wrong = chi2_bounds(rows[:, 3], total_edf("mtotdev", alpha, factors, n_phase), 0.683, quantiles="stable32")
-        assert abs(wrong[1][-1] / rows[-1, 4] - 1) > 9e-4
-    b, c = np.where(alpha == 0, 1.10, 1.20), np.where(alpha == 0, 1.20, 1.40)
-    nist = chi2_bounds(rows[:, 3], b * n_phase / factors - c, 0.683, quantiles="stable32")
-    assert np.all(nist[0] < lci) and np.all(nist[1] > uci)  # Table 8's are wider
+    lci, uci = chi2_bounds(rows[:, 3], edf, quantiles="stable32")  # one sigma
+    np.testing.assert_allclose(lci, rows[:, 2], rtol=8e-5)  # 5 printed digits
+    np.testing.assert_allclose(uci, rows[:, 4], rtol=8e-5)
+    if n_given != n_phase:  # with the phase count the frequency tables' last bound misses by 3.7e-4 and more
+        wrong = chi2_bounds(rows[:, 3], total_edf("mtotdev", alpha, factors, n_phase), quantiles="stable32")
+        assert abs(wrong[1][-1] / rows[-1, 4] - 1) > 3e-4
+    table_8 = {0: (1.10, 1.20), 1: (1.20, 1.40), -1: (0.85, 0.50)}
+    b, c = np.array([table_8[a] for a in alpha]).T
+    nist = chi2_bounds(rows[:, 3], b * n_phase / factors - c, quantiles="stable32")
+    assert not np.allclose(nist[1], rows[:, 4], rtol=1e-3, atol=0)  # Table 8 misses them all
+    assert np.all((nist[0] < lci) & (nist[1] > uci) | (alpha == -1))  # wider at white FM and flicker PM
 
 
 def test_theo1_with_a_fixed_noise_is_scaled_by_theobr_as_stable32():

@@ -19,8 +19,9 @@ import numpy as np
 from avar._validation import short_repr
 from avar.stability.chi2 import DEFAULT_CONFIDENCE, chi2_bounds
 
-__all__ = ["DEFAULT_CONFIDENCE", "EDF_ESTIMATORS", "ESTIMATORS", "J_MAX", "chi2_bounds", "estimator_edf", "gap_scaled_edf",
-           "greenhall_edf", "simple_edf", "totdev_edf"]
+__all__ = ["DEFAULT_CONFIDENCE", "EDF_ESTIMATORS", "ESTIMATORS", "J_MAX", "STABLE32_SIMPLE_EDF_OFFSET", "TOTDEV_EDF",
+           "chi2_bounds", "estimator_edf", "gap_scaled_edf", "greenhall_edf", "simple_edf", "stable32_simple_edf",
+           "totdev_edf"]
 
 #: Greenhall's J_max: beyond it, tables or a summed stride replace the full sum.
 J_MAX = 100
@@ -43,8 +44,17 @@ _TABLE2 = np.array([
     [_NA, (1.079, 0.368), (1.033, 0.607)], [_NA, _NA, (1.053, 0.553)], [_NA, _NA, (1.302, 0.535)],
 ])
 _TABLE3 = np.array([(6.0, 4.0), (15.23, 12.0), (47.8, 40.0)])
-# NIST SP 1065, Table 7: TOTVAR edf = b N / m - c for white, flicker and random-walk FM.
-_TOTDEV_TABLE = {0: (1.50, 0.0), -1: (1.17, 0.22), -2: (0.93, 0.36)}
+#: TOTVAR edf = b N / m - c for white, flicker and random-walk FM, N the number of points given, as
+#: Stable32's bounds imply: b = 1.168, 0.927 and c = 0.358 of Howe's TOTVAR fits (NIST SP 1065 Table 7,
+#: and ``allantools``, round them to 1.17, 0.93, 0.36), c = 0.22 at flicker FM. On a 1253-point record
+#: (given as phase and as frequency) they reproduce Stable32's bounds at flicker FM (EDF 3.4 to 1463),
+#: random-walk FM (580.4; Table 7's rounding: 582.3) and white FM to 6.6e-5.
+TOTDEV_EDF = {0: (1.500, 0.0), -1: (1.168, 0.22), -2: (0.927, 0.358)}
+#: What Stable32 adds to NIST SP 1065 Table 5's simple EDF where a total statistic takes it (TOTDEV at
+#: white and flicker PM, HTOTDEV below m = 16 and at PM). No source states it; Stable32's printed
+#: bounds imply it on four records (N = 1001, 1253, 55 688, 241 217 phase points; flicker PM, white,
+#: flicker and random-walk FM; EDF 18 to 1090): 2.00 +- 0.02 wherever the bounds resolve it.
+STABLE32_SIMPLE_EDF_OFFSET = 2.0
 
 
 def greenhall_edf(alpha: Any, d: int, m: Any, n_phase: int, overlapping: bool, modified: bool) -> np.ndarray:
@@ -185,24 +195,27 @@ def _white_pm_inverse(big_m: np.ndarray, r: np.ndarray, d: int) -> np.ndarray:
 
 
 def totdev_edf(n_phase: int, m: Any, alpha: Any) -> np.ndarray:
-    """Equivalent degrees of freedom of the total deviation (NIST SP 1065, Table 7).
+    """Equivalent degrees of freedom of the total deviation (Howe 2000; NIST SP 1065, Table 7).
 
     For white, flicker and random-walk FM (alpha = 0, -1, -2)::
 
-        edf = b N / m - c,  (b, c) = (1.50, 0), (1.17, 0.22), (0.93, 0.36)
+        edf = b N / m - c,  (b, c) = (1.500, 0), (1.168, 0.22), (0.927, 0.358)
 
-    with N the number of phase points (T / tau = N / m, as ``allantools``). SP
-    1065 gives no TOTVAR EDF for white and flicker PM (alpha = 2, 1); there
-    the handbook's simple approximations for the Allan variance (its Table 5,
-    Stein 1985) are used, as ``allantools`` does:
-    alpha = 2: (N + 1)(N - 2m) / (2 (N - m)); alpha = 1:
-    exp(sqrt(ln((N - 1) / 2m) ln((2m + 1)(N - 1) / 4))). Those two fall to 0
-    (or are undefined) as m reaches N / 2: every EDF is floored at 1.
+    with N the number of data points (T / tau = N / m; Stable32 counts the
+    points given, phase or frequency); SP 1065's Table 7 rounds b to two
+    decimals (see :data:`TOTDEV_EDF`). SP 1065 gives no TOTVAR EDF for white and
+    flicker PM (alpha = 2, 1); there, as Stable32, the handbook's simple
+    approximations for the Allan variance (its Table 5, Stein 1985) plus 2
+    (:data:`STABLE32_SIMPLE_EDF_OFFSET`): alpha = 2: (N + 1)(N - 2m) / (2 (N - m)) + 2;
+    alpha = 1: exp(sqrt(ln((N - 1) / 2m) ln((2m + 1)(N - 1) / 4))) + 2. Those
+    two fall to 0 (or are undefined) as m reaches N / 2: every EDF is floored at 1.
+    ``allantools`` takes Table 7's rounded coefficients and Table 5 without the 2.
 
     Parameters
     ----------
     n_phase : int
-        Number of phase points N.
+        Number of data points N: Stable32 counts those given (frequency data: one
+        fewer than their phase points).
     m : int or array_like of int
         Averaging factors.
     alpha : int or array_like of int
@@ -222,18 +235,18 @@ def totdev_edf(n_phase: int, m: Any, alpha: Any) -> np.ndarray:
     --------
     >>> totdev_edf(1001, [1, 16, 256], 0).round(3)
     array([1501.5  ,   93.844,    5.865])
-    >>> totdev_edf(1001, 16, [0, -1, -2]).round(3)
-    array([93.844, 72.978, 57.823])
+    >>> totdev_edf(1001, 16, [0, -1, -2, 1]).round(3)
+    array([ 93.844,  72.853,  57.637, 264.791])
     """
     m, alpha = _check_levels(m, alpha, "m", "alpha")
     if ((alpha < -2) | (alpha > 2)).any():
         raise ValueError(f"alpha must be in -2 .. 2 for totdev_edf, got {short_repr(np.unique(alpha).tolist())}")
     n = float(_check_count(n_phase, "n_phase"))
-    if (m >= n).any():
-        raise ValueError(f"m must be < n_phase = {int(n)}, got {short_repr(np.unique(m[m >= n]).tolist())}")
+    if (m > n).any():  # m = N: the longest level of N frequency values
+        raise ValueError(f"m must be <= n_phase = {int(n)}, got {short_repr(np.unique(m[m > n]).tolist())}")
     m, alpha = np.broadcast_arrays(m.astype(np.float64), alpha)
-    edf = simple_edf(n, m, alpha)
-    for a, (b, c) in _TOTDEV_TABLE.items():
+    edf = stable32_simple_edf(n, m, alpha)
+    for a, (b, c) in TOTDEV_EDF.items():
         edf = np.where(alpha == a, b * n / m - c, edf)
     return np.where(np.isnan(edf) | (edf < 1), 1.0, edf)
 
@@ -249,9 +262,9 @@ def simple_edf(n_phase: float, m: np.ndarray, alpha: np.ndarray) -> np.ndarray:
         random-walk   (N - 2) / m ((N - 1)^2 - 3 m (N - 1) + 4 m^2) / (N - 3)^2
 
     TOTDEV's at white and flicker PM (where Table 7 has none) and HTOTDEV's below m = 16 and at
-    PM: Stable32's bounds follow them (HTOTDEV: within 1.3 % of the EDF its bounds imply on two
-    records, where the overlapping Hadamard variance's Greenhall EDF is 10 to 36 % lower;
-    simulated records have more still, ``benchmarks/total_edf_simulation.py``).
+    PM take them plus 2, as Stable32 (:func:`stable32_simple_edf`; the overlapping Hadamard
+    variance's Greenhall EDF is 10 to 36 % lower there, simulated records have more still:
+    ``benchmarks/total_edf_simulation.py``).
 
     >>> simple_edf(1001, np.array([1, 8, 1, 4]), np.array([0, 0, -1, -2])).round(2).tolist()
     [665.78, 181.95, 868.81, 247.76]
@@ -267,6 +280,18 @@ def simple_edf(n_phase: float, m: np.ndarray, alpha: np.ndarray) -> np.ndarray:
         rwfm = (n - 2) / m * ((n - 1) ** 2 - 3 * m * (n - 1) + 4 * m * m) / (n - 3) ** 2
     return np.select([alpha == 2, alpha == 1, alpha == 0, alpha == -1, alpha == -2], [wpm, fpm, wfm, ffm, rwfm],
                      np.nan)
+
+
+def stable32_simple_edf(n_phase: float, m: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """:func:`simple_edf` + 2: Stable32's EDF where a total statistic takes the simple approximations.
+
+    TOTDEV at white and flicker PM, HTOTDEV below m = 16 and at PM (see
+    :data:`STABLE32_SIMPLE_EDF_OFFSET` for the evidence).
+
+    >>> stable32_simple_edf(1001, np.array([256, 8]), np.array([1, 0])).round(3).tolist()
+    [18.544, 183.95]
+    """
+    return simple_edf(n_phase, m, alpha) + STABLE32_SIMPLE_EDF_OFFSET
 
 
 def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: int) -> np.ndarray:

@@ -203,8 +203,8 @@ def mtotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus:
     n = N - 3m + 1 terms. Dimensionless. The noise is identified by TOTDEV's
     lag-1 rule and, where few averages remain, B1 with n terms (as Stable32).
     EDF: the modified Allan variance's (Greenhall) below m = 10, as Stable32,
-    then Stable32's b (N - 1) / m - c at white FM and flicker PM and NIST SP 1065
-    Table 8's b N / m - c at the other noises (see
+    then Stable32's b (N - 1) / m - c at white FM, flicker PM and flicker FM and
+    NIST SP 1065 Table 8's b N / m - c at the other noises (see
     :func:`avar.stability.total_edf.total_edf`).
     ``bias_correction=True`` divides by MTOTVAR / MVAR (0.94, 0.83, 0.73, 0.70,
     0.69 for alpha = 2 .. -2), as Stable32 when its bias removal is on; its
@@ -266,9 +266,9 @@ def htotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus:
     ``bias_correction=True`` (default, Stable32) divides by E[Htot var] / Hvar
     = 1 + a for m > 1, a = -0.005, -0.149, -0.229 for alpha = 0, -1, -2 (none
     for PM noise); ``allantools`` applies none. Noise identified as for
-    :func:`mtotdev`. EDF: NIST SP 1065 Table 5's below m = 16 and at PM, then
-    (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`),
-    as Stable32's printed bounds (to 4e-4 below m = 16, to 1.2e-4 from there).
+    :func:`mtotdev`. EDF: NIST SP 1065 Table 5's plus 2 below m = 16 and at PM,
+    then (N / m) / (b0 + b1 m / N) (see :func:`avar.stability.total_edf.total_edf`),
+    as Stable32's printed bounds.
     Each level costs O(N), as :func:`mtotdev`.
     {parameters}
     References

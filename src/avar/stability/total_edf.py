@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from avar._validation import short_repr
-from avar.stability.edf import estimator_edf, simple_edf
+from avar.stability.edf import estimator_edf, stable32_simple_edf
 from avar.stability.grids import grid_factors
 
 TOTAL_ESTIMATORS = ("mtotdev", "ttotdev", "htotdev", "theo1", "theoh")
@@ -39,17 +39,19 @@ TOTAL_LONG_NAMES = {
 
 #: NIST SP 1065 Table 8: MTOTVAR (and TTOTVAR) EDF = b N / m - c.
 MTOT_EDF = {2: (1.90, 2.10), 1: (1.20, 1.40), 0: (1.10, 1.20), -1: (0.85, 0.50), -2: (0.75, 0.31)}
-#: Stable32's MTOTVAR EDF from m = 10 where it differs from Table 8: b (N - 1) / m - c for white FM
-#: and flicker PM (no published source; inverted from its printed bounds of two records, N = 1001
-#: and 1253, where it reproduces all of them to 6e-4).
-STABLE32_MTOT_EDF = {0: (4.0 / 3.0, 1.89), 1: (1.734, 2.99)}
+#: Stable32's MTOTVAR (and TTOTVAR) EDF from m = 10 where it differs from Table 8: b (N - 1) / m - c
+#: at white FM, flicker PM and flicker FM, N the number of points given. No source states it; these
+#: are least-squares fits to the degrees of freedom its printed one-sigma bounds imply on two records
+#: (N = 1001 and 1253, given as phase and as frequency; 36, 7 and 8 rows), which they reproduce to
+#: 1.2e-4, 6e-5 and 5e-5 (3 units of the 5th printed digit at most). Flicker FM rests on one record.
+STABLE32_MTOT_EDF = {0: (1.3313, 1.8927), 1: (1.7319, 2.9896), -1: (0.9204, 0.7596)}
 #: Below this factor MTOTDEV's (and TTOTDEV's) EDF is the modified Allan variance's, as
 #: Stable32's bounds show (PHASE.DAT: MDEV's EDF at m = 1 .. 8, a b N / m - c law from m = 10).
 MTOT_EDF_FROM = 10
 #: NIST SP 1065 (Howe et al. 2000): HTOTVAR EDF = (N / m) / (b0 + b1 m / N), for m >= 16.
 HTOT_EDF = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696)}
-#: Below this factor HTOTDEV's EDF is NIST SP 1065 Table 5's simple approximation (Stable32 switches
-#: here; its printed bounds below m = 16 follow Table 5, not the Greenhall EDFs).
+#: Below this factor HTOTDEV's EDF is NIST SP 1065 Table 5's simple approximation plus 2 (Stable32
+#: switches here; its printed bounds below m = 16 follow that, not the Greenhall EDFs).
 HTOT_EDF_FROM = 16
 #: Howe et al. 2000: E[HTOTVAR] / HVAR = 1 + a (m > 1); Stable32 divides by it.
 HTOT_BIAS = {0: -0.005, -1: -0.149, -2: -0.229}
@@ -138,26 +140,28 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
     Stable32's MTOTVAR law takes for its N; default ``n_phase``.
 
     * MTOTDEV, TTOTDEV: the modified Allan variance's (Greenhall) below m = 10,
-      as Stable32; from m = 10 Stable32's 4/3 (N - 1) / m - 1.89 (white FM) and
-      1.734 (N - 1) / m - 2.99 (flicker PM), b N / m - c (NIST SP 1065, Table 8)
-      for the other noises. Stable32's law is published nowhere; it reproduces
-      its printed bounds of two records of different length (N = 1001 and 1253)
-      to 6e-4, with N the number of points given (its frequency and phase tables
-      of one record differ so). Simulated records have 20 to 50 % fewer degrees of freedom
-      (``benchmarks/total_edf_simulation.py``: white FM, N = 1001, m = 16:
-      64 against Stable32's 81.5 and Table 8's 67.6), so these bounds, as
-      Stable32's, are narrower than the data warrant there by up to about 10 %;
-      ``MTOT_EDF`` holds Table 8's coefficients for all five noises.
+      as Stable32; from m = 10 Stable32's b (N - 1) / m - c with (b, c) =
+      (1.3313, 1.8927) at white FM, (1.7319, 2.9896) at flicker PM and
+      (0.9204, 0.7596) at flicker FM (:data:`STABLE32_MTOT_EDF`), NIST SP 1065
+      Table 8's b N / m - c at white PM and random-walk FM. Stable32's law is
+      published nowhere; fitted to the bounds it prints for two records of
+      different length (N = 1001 and 1253), it reproduces them to 1.2e-4, with
+      N the number of points given (its frequency and phase tables of one
+      record differ so). Simulated records have 20 to 50 % fewer degrees of
+      freedom (``benchmarks/total_edf_simulation.py``: white FM, N = 1001,
+      m = 16: 64 against Stable32's 81.3 and Table 8's 67.6), so these bounds,
+      as Stable32's, are narrower than the data warrant there by up to about
+      10 %; ``MTOT_EDF`` holds Table 8's coefficients for all five noises.
     * HTOTDEV: from m = 16 (Stable32) (N / m) / (b0 + b1 m / N) with (b0, b1)
       = (0.559, 1.004), (0.868, 1.140), (0.938, 1.696) for alpha = 0, -1, -2
-      (NIST SP 1065); below m = 16 and at white and flicker PM the simple
-      approximations of NIST SP 1065 Table 5
-      (:func:`avar.stability.edf.simple_edf`), which Stable32's bounds follow:
-      its EDFs on two records (N = 1001, 1253; white, flicker and random-walk
-      FM, m = 1 .. 10) are 0.4 to 1.3 % above them, where the overlapping
-      Hadamard variance's Greenhall EDF is 10 to 36 % lower. Simulated records
-      have more than either (597, 385, 208 at m = 2, 4, 8, white FM,
-      N = 1001; Table 5: 570, 346, 182).
+      (NIST SP 1065); below m = 16 and at white and flicker PM Stable32's
+      simple approximations of NIST SP 1065 Table 5 plus 2
+      (:func:`avar.stability.edf.stable32_simple_edf`), which its bounds on
+      two records (N = 1001, 1253; flicker PM, white, flicker and random-walk
+      FM) imply to +-0.02 degrees of freedom, where the overlapping Hadamard
+      variance's Greenhall EDF is 10 to 36 % lower. Simulated records have
+      more than either (597, 385, 208 at m = 2, 4, 8, white FM, N = 1001;
+      Table 5 + 2: 572, 348, 184).
     * Theo1 (Howe and Tasset 2004; NIST SP 1065, Table 11), r = 0.75 m:
       alpha = 2: 0.86 (N + 1)(N - 4r/3) / (N - r) * r / (r + 1.14);
       1: (4.798 N**2 - 6.374 N r + 12.387 r) / (sqrt(r + 36.6) (N - r)) * r / (r + 0.3);
@@ -168,7 +172,7 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
     Examples
     --------
     >>> total_edf("mtotdev", np.array([0, -2]), np.array([10, 10]), 1001).round(3).tolist()
-    [131.443, 74.765]
+    [131.237, 74.765]
     >>> total_edf("theo1", np.array([0]), np.array([100]), 1001).round(3).tolist()
     [51.215]
     """
@@ -191,11 +195,12 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
                 value[small] = estimator_edf("mdev", np.full(int(small.sum()), a), mm[small].astype(np.int64),
                                              int(n_phase))
             edf[at] = value
-        elif estimator == "htotdev":
-            value = simple_edf(n, mm, np.full(mm.shape, a))
+        elif estimator == "htotdev":  # N: the count given, as Stable32 (its frequency tables)
+            given = float(n_phase if n_given is None else n_given)
+            value = stable32_simple_edf(given, mm, np.full(mm.shape, a))
             if int(a) in HTOT_EDF:
                 b0, b1 = HTOT_EDF[int(a)]
-                value = np.where(mm >= HTOT_EDF_FROM, (n / mm) / (b0 + b1 * mm / n), value)
+                value = np.where(mm >= HTOT_EDF_FROM, (given / mm) / (b0 + b1 * mm / given), value)
             edf[at] = value
         else:
             edf[at] = _theo1_edf(int(a), n, 0.75 * mm)
