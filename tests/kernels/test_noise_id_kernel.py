@@ -30,14 +30,47 @@ def test_kernel_equals_the_numpy_twin(kind, dmax):
     for seed in range(6):
         x = series(kind, 5000, seed)
         for m in (1, 2, 3, 7, 16, 64, 150):
-            got, expected = lag1_alpha_decimated(x, m, dmax), plain_alpha(x, m, dmax)
+            got, expected = lag1_alpha_decimated(x, m, dmax, np.nan), plain_alpha(x, m, dmax)
             assert got == expected, (kind, seed, m)
             hits += 1
     assert hits == 42
 
 
+@pytest.mark.parametrize("kind", ["white pm", "white fm", "rw fm"])
+@pytest.mark.parametrize("dmax", [2, 3])
+def test_phase_data_keep_their_line(kind, dmax):
+    # phase data: the kernel gets the line the caller removed back and takes only the mean off,
+    # as the twin does with the decimated phase as given (no least-squares line)
+    decided = {}
+    for seed in range(6):
+        w = np.random.default_rng(seed).standard_normal(1200)
+        given = {"white pm": w, "white fm": np.cumsum(w), "rw fm": np.cumsum(np.cumsum(w))}[kind]
+        given = given + 0.02 * np.arange(1200) * given.std() / 1200  # a small frequency offset
+        slope = (given[-1] - given[0]) / 1199
+        detrended = given - slope * np.arange(1200)
+        for m in (1, 2, 5, 16, 40):
+            got = lag1_alpha_decimated(detrended, m, dmax, slope)
+            assert got == lag1_alpha(given[::m], dmax), (kind, seed, m)
+            decided[got] = decided.get(got, 0) + 1
+    assert len(decided) >= 1 and sum(decided.values()) == 30
+
+
+def test_a_large_frequency_offset_of_phase_data_keeps_its_digits():
+    # 1e12 times the noise: the offset sends order 0 to the differences, which the kernel forms
+    # from the least-squares residuals; white PM and white FM are still told apart
+    for seed in range(4):
+        w = np.random.default_rng(seed).standard_normal(3000)
+        for noise, alpha in ((w, 2.0), (np.cumsum(w), 0.0)):
+            assert lag1_alpha_decimated(noise, 1, 2, 1e12) == alpha
+            assert lag1_alpha_decimated(noise, 1, 2, 0.0) == alpha  # no offset: order 0 decides the same
+    # the line matters at order 0 where the noise alone would stop there: white PM with a moderate offset
+    w = np.random.default_rng(9).standard_normal(3000)
+    assert lag1_alpha_decimated(w, 1, 2, 0.0) == 2.0 and lag1_alpha(w + 0.01 * np.arange(3000), 2) == 2.0
+
+
 def test_constant_series_gives_nan():
-    assert np.isnan(lag1_alpha_decimated(np.full(100, 3.5), 1, 2))
+    assert np.isnan(lag1_alpha_decimated(np.full(100, 3.5), 1, 2, np.nan))
+    assert np.isnan(lag1_alpha_decimated(np.full(100, 3.5), 1, 2, 0.0))
 
 
 @pytest.mark.parametrize("factors", [[1, 2, 4, 8, 16, 32, 64, 128], [1, 3, 6, 7, 14, 100, 200], [5], [2, 4]])
@@ -46,12 +79,13 @@ def test_levels_serial_split_and_single_agree(factors):
 
     x = series("white fm", 20_000, 1)
     m = np.array(factors, dtype=np.int64)
-    serial, split = np.empty(m.size), np.empty(m.size)
-    lag1_levels(x, m, 2, serial)
-    lag1_levels_split(x, m, 2, split)
-    single = [lag1_alpha_decimated(x, int(f), 2) for f in m]
-    np.testing.assert_array_equal(serial, single)
-    np.testing.assert_array_equal(split, single)
+    for line in (np.nan, 0.0, -0.5):  # frequency data; phase data as given and less a line
+        serial, split = np.empty(m.size), np.empty(m.size)
+        lag1_levels(x, m, 2, line, serial)
+        lag1_levels_split(x, m, 2, line, split)
+        single = [lag1_alpha_decimated(x, int(f), 2, line) for f in m]
+        np.testing.assert_array_equal(serial, single)
+        np.testing.assert_array_equal(split, single)
 
 
 @pytest.mark.parametrize("kind", ["white pm", "white fm"])
@@ -60,7 +94,7 @@ def test_a_frequency_drift_stays_for_the_differences(kind):
     # the twin reproduces, and second differences still read white PM / white FM
     for seed in range(4):
         x = series(kind, 3000, seed) + 1e-3 * np.arange(3000.0) ** 2
-        got = lag1_alpha_decimated(x, 1, 2)
+        got = lag1_alpha_decimated(x, 1, 2, np.nan)
         assert got == plain_alpha(x, 1, 2) == (2.0 if kind == "white pm" else 0.0)
 
 

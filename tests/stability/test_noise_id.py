@@ -42,12 +42,14 @@ def test_powerlaw_helper_has_the_allan_slopes():
     assert slopes[-2] == pytest.approx(0.5, abs=0.15)
 
 
-def plain_stable32_lag1(x, m, dmax):
-    """Stable32's lag-1 rule as a loop: decimate, remove the least-squares line, then with
-    n points r1 = (sum of lag-1 products / n) / (sum of squares / (n - 1))."""
+def plain_stable32_lag1(x, m, dmax, from_frequency=False):
+    """Stable32's lag-1 rule as a loop: decimate (phase integrated from frequency data: remove
+    the least-squares line, their mean), then with n points
+    r1 = (sum of lag-1 products / n) / (sum of squares / (n - 1)) of the points less their mean."""
     z = np.asarray(x[::m], dtype=float)
-    t = np.arange(z.size)
-    z = z - np.polyval(np.polyfit(t, z, 1), t)
+    if from_frequency:
+        t = np.arange(z.size)
+        z = z - np.polyval(np.polyfit(t, z, 1), t)
     for d in range(dmax + 1):
         c = z - z.mean()
         r1 = sum(c[i] * c[i + 1] for i in range(c.size - 1)) / c.size / (sum(c * c) / (c.size - 1))
@@ -59,8 +61,8 @@ def plain_stable32_lag1(x, m, dmax):
 
 @pytest.mark.parametrize("estimator, dmax", [("adev", 2), ("ohdev", 3)])
 def test_lag1_is_the_plain_rule_and_mostly_allantools(series, estimator, dmax):
-    # Stable32 removes a line (allantools a quadratic) and divides the variance by n - 1
-    # (allantools by n): the same decisions but near a rounding boundary
+    # Stable32 removes the mean of phase data (a line from frequency data; allantools a quadratic)
+    # and divides the variance by n - 1 (allantools by n): the same decisions but near a boundary
     factors = [1, 2, 4, 16, 64, 256]  # N / m >= 30: the lag-1 method in both
     compared = same_as_allantools = 0
     for (alpha, seed), x in series.items():
@@ -69,6 +71,8 @@ def test_lag1_is_the_plain_rule_and_mostly_allantools(series, estimator, dmax):
         ours = identify_noise(x, factors, estimator)
         plain = [plain_stable32_lag1(x, m, dmax) for m in factors]
         np.testing.assert_array_equal(ours, plain, err_msg=f"alpha={alpha} seed={seed}")
+        integrated = identify_noise(x, factors, estimator, from_frequency=True)
+        np.testing.assert_array_equal(integrated, [plain_stable32_lag1(x, m, dmax, True) for m in factors])
         theirs = np.clip([atci.autocorr_noise_id(x, m, data_type="phase", dmax=dmax)[0] for m in factors], -2, 2)
         same_as_allantools += int((ours == theirs).sum())
         compared += len(factors)

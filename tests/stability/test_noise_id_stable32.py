@@ -161,3 +161,20 @@ def test_totals_read_b1_with_their_own_term_count_down_to_6_averages():
     assert b1_rule("mtotdev", 1253, 201, 6) == (True, 1253 - 3 * 201 + 1)
     assert b1_rule("htotdev", 1253, 201, 6) == (True, 1253 - 3 * 201)
     assert b1_rule("ttotdev", 1253, 209, 5)[0] is False and b1_rule("totdev", 1253, 209, 5)[0] is True
+
+
+def test_phase_data_keep_their_frequency_offset_as_in_stable32():
+    # A caesium clock's phase at the factors where 30 to 77 averages remain: Stable32 reads white
+    # FM (alpha 0) from the decimated phase less its mean; less its least-squares line (the rule
+    # for phase integrated from frequency data) the same points read as white PM
+    rows = np.loadtxt(DATA / "cs5071a_decimated.txt")
+    for m in (7197, 10098, 14167):
+        points = rows[rows[:, 0] == m, 2]
+        assert points.size == 556_989 // m + 1
+        assert identify_noise(points, [1], "oadev").tolist() == [0]
+        assert identify_noise(points, [1], "oadev", from_frequency=True).tolist() == [2]
+        # the whole path of a deviation: a phase record whose every m-th point is these
+        full = np.interp(np.arange((points.size - 1) * m + 1) / m, np.arange(points.size), points)
+        for estimator in ("oadev", "adev", "mdev", "ohdev", "totdev"):
+            res = getattr(avar, estimator)(full, data_type="phase", taus=[float(m)])
+            assert res.alpha.tolist() == [0], (estimator, m)

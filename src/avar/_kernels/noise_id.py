@@ -1,7 +1,8 @@
 """Lag-1 autocorrelation noise identification (numba).
 
-Per averaging factor m: decimate the phase to x[0], x[m], x[2m], ..., remove a
-least-squares line (the frequency offset, as Stable32), then difference until the lag-1
+Per averaging factor m: decimate the phase to x[0], x[m], x[2m], ..., remove its mean
+(phase data) or its least-squares line (phase integrated from frequency data: the mean
+frequency), as Stable32, then difference until the lag-1
 autocorrelation says the series is stationary enough. Two streaming passes over the K = N / m
 decimated points and no workspace: the first sums the line's
 projections, the second forms the residuals and their differences on the fly and
@@ -26,13 +27,18 @@ QUADRATIC = False
 
 
 @njit(cache=True, nogil=True)
-def lag1_alpha_decimated(x, m, dmax):
+def lag1_alpha_decimated(x, m, dmax, line):
     """alpha of x[0], x[m], x[2m], ... by the lag-1 autocorrelation (Riley and Greenhall 2004).
 
-    The decimated series z (K points) loses its least-squares line (the
+    ``line`` NaN (phase integrated from frequency data): the decimated series
+    z (K points) loses its least-squares line, the mean frequency (the
     quadratic too if :data:`QUADRATIC`), computed with the discrete orthogonal
     polynomials 1, t, t**2 - (K**2 - 1) / 12 of the centred index t (sums, no
-    linear system). Then, with n points left,
+    linear system). ``line`` a number (phase data): ``x`` lacks ``line * i``,
+    which the phase data had; z is taken with it and loses only its mean, as
+    Stable32 (the differences, d >= 1, do not see the line; they are formed
+    from the least-squares residuals, which keeps a large frequency offset
+    from cancelling their digits). Then, with n points left,
     r1 = (sum (z_i - zbar)(z_{i+1} - zbar) / n) / (sum (z_i - zbar)**2 / (n - 1)) and
     rho = r1 / (1 + r1), z is differenced until rho < 0.25 or d = dmax, and
     alpha = 2 - round(2 rho) - 2 d (round half to even, as ``numpy.round``).
@@ -50,6 +56,10 @@ def lag1_alpha_decimated(x, m, dmax):
     for d in range(dmax + 1):
         if d % 2 == 0:  # orders d and d + 1 in one pass (most series stop at d = 0 or 1)
             _order_pass(x, m, k, half, c2, a0, a1, a2, d, stats)
+            if d == 0 and not np.isnan(line):  # order 0 of the phase as given: only its mean removed
+                given = np.zeros((2, 5))
+                _order_pass(x, m, k, half, c2, a0, -line * m, 0.0, 0, given)
+                stats[0, :] = given[0, :]
         length = k - d
         total, squares, products, first, last = stats[d, 0], stats[d, 1], stats[d, 2], stats[d, 3], stats[d, 4]
         mean = total / length
@@ -119,27 +129,27 @@ def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
 
 
 @njit(cache=True, nogil=True)
-def lag1_levels(x, factors, dmax, out):
+def lag1_levels(x, factors, dmax, line, out):
     """:func:`lag1_alpha_decimated` at every factor into ``out``, serially."""
     for i in range(factors.shape[0]):
-        out[i] = lag1_alpha_decimated(x, factors[i], dmax)
+        out[i] = lag1_alpha_decimated(x, factors[i], dmax, line)
 
 
-def lag1_levels_split(x, factors, dmax, out):
+def lag1_levels_split(x, factors, dmax, line, out):
     """:func:`lag1_levels` on two threads: the first level (the longest; at the octave
     m = 1 it holds half the points) on one, the others on the other."""
 
     def worker(w):
         if w == 0:
-            out[0] = lag1_alpha_decimated(x, factors[0], dmax)
+            out[0] = lag1_alpha_decimated(x, factors[0], dmax, line)
         else:
-            _decimating_levels(x, factors, dmax, out)
+            _decimating_levels(x, factors, dmax, line, out)
 
     run_tasks(2, worker)
 
 
 @njit(cache=True, nogil=True)
-def _decimating_levels(x, factors, dmax, out):
+def _decimating_levels(x, factors, dmax, line, out):
     """Levels 1, 2, ... of :func:`lag1_levels_split`: where a factor is a multiple of the one
     before (octaves), the decimated points are taken from that level's contiguous copy
     (decimated in place) rather than from ``x`` at a long stride: the same values, fewer
@@ -162,7 +172,7 @@ def _decimating_levels(x, factors, dmax, out):
             for j in range(length):
                 buffer[j] = x[j * m]
         held = m
-        out[i] = lag1_alpha_decimated(buffer[:length], 1, dmax)
+        out[i] = lag1_alpha_decimated(buffer[:length], 1, dmax, line * m)
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST)

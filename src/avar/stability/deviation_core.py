@@ -132,10 +132,12 @@ def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple
     frequency data) with its mean frequency (and, for HDEV and OHDEV, its
     linear frequency drift) removed, the gap mode and the prefix count of
     gaps (see :mod:`avar._kernels.deviations`); then ``phase``, the
-    detrended phase ``hi`` itself (for MDEV, before its running sum), and
+    detrended phase ``hi`` itself (for MDEV, before its running sum),
     ``drift``: ``phase`` lacks ``drift * k (k - 1) / 2`` (the Hadamard family's
-    removed linear frequency drift). ``scanned``: :func:`scan` of ``data`` if
-    already known.
+    removed linear frequency drift), and ``line``: for phase data, ``phase``
+    lacks ``line * k`` too (their frequency offset, which Stable32's noise
+    identification sees); None for frequency data. ``scanned``: :func:`scan`
+    of ``data`` if already known.
     """
     is_phase = data_type == "phase"
     n_missing, total, low, high, moment = scan(data) if scanned is None else scanned
@@ -161,7 +163,7 @@ def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple
         detrended_phase(hi, lo, 2, float(np.mean(hi)), 0.0, 1.0, running_hi, running_lo)
         hi, lo = running_hi, running_lo
     mode = 0 if bad is None else (1 if is_phase else 2)
-    return hi, lo, scale, mode, bad, phase, slope * scale
+    return hi, lo, scale, mode, bad, phase, slope * scale, (centre * scale if is_phase else None)
 
 
 def deviation_levels(
@@ -204,17 +206,19 @@ def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.nda
                                rate: float = 1.0, scanned: tuple | None = None):
     """:func:`deviation_levels` and what the noise identification needs.
 
-    Returns ``variance, n, phase, drift``: ``phase`` the detrended phase it
+    Returns ``variance, n, phase, drift, line``: ``phase`` the detrended phase it
     used (scaled by a power of two, as in :func:`phase_parts`) or, on the
-    pyramid's path, an :class:`OctaveMoments`; ``drift`` as in :func:`phase_parts`.
+    pyramid's path (frequency data), an :class:`OctaveMoments`; ``drift`` and
+    ``line`` as in :func:`phase_parts`.
     """
     factors = np.asarray(factors, dtype=np.int64)
     n_phase = data.shape[0] + (data_type == "freq")
     scanned = scan(data) if scanned is None else scanned
     if estimator in ("adev", "hdev") and data_type == "freq" and scanned[0] == 0 and _is_octave(factors):
         sums, counts, scale, phase, drift = _octave_sums(estimator, data, factors, scanned)
+        line = None
     else:
-        hi, lo, scale, mode, bad, phase, drift = phase_parts(data, data_type, estimator, scanned)
+        hi, lo, scale, mode, bad, phase, drift, line = phase_parts(data, data_type, estimator, scanned)
         strides, first, last = term_ranges(estimator, n_phase, factors)
         sums, counts = level_sums(hi, lo, KERNEL_CODES[estimator], factors, strides, first, last, mode, bad)
     m = factors.astype(np.float64)
@@ -227,4 +231,4 @@ def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.nda
             tau = m / rate
             variance = variance * tau * tau / 3.0
     variance[counts == 0] = np.nan
-    return variance, counts, phase, drift
+    return variance, counts, phase, drift, line

@@ -89,22 +89,24 @@ def noise_exponents(estimator: str, values: np.ndarray, data_type: str, rate: fl
     alpha = np.zeros(factors.size, dtype=np.int64)
     fits = factors < stretch.size
     if stretch.size >= 4 and fits.any():
-        alpha[fits] = identify_noise(stretch, factors[fits], estimator)
+        alpha[fits] = identify_noise(stretch, factors[fits], estimator, from_frequency=data_type == "freq")
         alpha[~fits] = alpha[fits][-1]
     return alpha
 
 
 def _noise_of_levels(estimator: str, phase: np.ndarray | OctaveMoments, drift: float,
-                        factors: np.ndarray) -> np.ndarray:
+                     factors: np.ndarray, line: float | None) -> np.ndarray:
     """:func:`noise_exponents` of gap-free data from the detrended phase of the variances,
-    or from the moments of the pyramid's levels."""
+    or from the moments of the pyramid's levels; ``drift`` and ``line`` (None: frequency
+    data) as in :func:`avar.stability.deviation_core.phase_parts`."""
     if isinstance(phase, OctaveMoments):
         return octave_noise(phase.stats, phase.tails, factors, NOISE_ID_ESTIMATORS[estimator], drift, phase.phase,
                             phase.clusters)
     alpha = np.zeros(factors.size, dtype=np.int64)
     fits = factors < phase.size
     if phase.size >= 4 and fits.any():
-        alpha[fits] = phase_noise(phase, factors[fits], NOISE_ID_ESTIMATORS[estimator], drift, line_free=True)
+        alpha[fits] = phase_noise(phase, factors[fits], NOISE_ID_ESTIMATORS[estimator], drift, line_free=True,
+                                  line=line)
         alpha[~fits] = alpha[fits][-1]
     return alpha
 
@@ -126,7 +128,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
     factors = deviation_factors(estimator, n_phase, rate, taus)
     values, scanned, exponent = scaled(values, scanned, drift_removed)
-    variance, n, phase, drift = deviation_levels_and_phase(estimator, values, factors, data_type, rate, scanned)
+    variance, n, phase, drift, line = deviation_levels_and_phase(estimator, values, factors, data_type, rate, scanned)
     n, variance, factors = levels_with_terms(estimator, n, (variance, factors),
                                              f"the {n_missing} NaN value(s) of data" if n_missing else None)
     deviation = np.ldexp(np.sqrt(variance), exponent)
@@ -142,7 +144,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     elif n_missing:
         alpha = noise_exponents(estimator, values, data_type, rate, factors)
     else:  # the variances' own detrended phase: no second pass over the data
-        alpha = _noise_of_levels(estimator, phase, drift, factors)
+        alpha = _noise_of_levels(estimator, phase, drift, factors, line)
     if bias_correction:
         bias = totvar_bias(alpha, factors, values.size)  # T = the record's count of points, as Stable32
         variance, deviation = variance / bias, deviation / np.sqrt(bias)

@@ -52,7 +52,7 @@ def chi2_band(column: np.ndarray, factors: np.ndarray, freq: float, type: str, a
     estimator = TYPE_ESTIMATORS[type]
     y = np.asarray(column, dtype=np.float64)
     phase = np.concatenate(([0.0], np.cumsum(y - y.mean()))) / freq  # the mean (a phase ramp) changes nothing
-    alpha = identify_noise(phase, factors, estimator)
+    alpha = identify_noise(phase, factors, estimator, from_frequency=True)
     edf = estimator_edf(estimator, alpha, factors, phase.size)
     lci, uci = chi2_bounds(np.sqrt(allan), edf, confidence)
     return alpha, edf, lci, uci

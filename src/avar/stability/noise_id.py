@@ -73,7 +73,7 @@ def b1_rule(estimator: str | None, n: int, m: int, k: int) -> tuple[bool, int]:
 RN_SUBSAMPLES = 64
 
 
-def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
+def identify_noise(phase: Any, factors: Any, estimator: str, *, from_frequency: bool = False) -> np.ndarray:
     """Dominant power-law noise exponent alpha (S_y(f) ~ f**alpha) at every averaging factor.
 
     For each m, with N phase points:
@@ -88,9 +88,13 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
        continuous limit its twice-differenced block means have rho = -0.04
        (Greenhall's s_z with F = 1), read as random-walk FM.
     2. If at least K = floor((N - 1) / m) = 30 frequency averages remain (compiled:
-       :func:`avar._kernels.noise_id.lag1_alpha_decimated`): remove a line
-       (the frequency offset; not a drift, as Stable32), then with r1 the lag-1
-       autocorrelation of the n points left, as Stable32 forms it,
+       :func:`avar._kernels.noise_id.lag1_alpha_decimated`): remove the
+       mean of the decimated phase (phase data, as they are) or its line
+       (``from_frequency``: the mean frequency); not a drift, as Stable32.
+       Stable32's tables of a 556,990-point caesium phase record show the
+       phase data's line kept: removing it misreads white FM as white PM
+       where 30 to 77 averages remain (31 rows of each of its all-tau tables).
+       Then with r1 the lag-1 autocorrelation of the n points left, as Stable32 forms it,
        r1 = (sum (z_i - zbar)(z_{i+1} - zbar) / n) / (sum (z_i - zbar)**2 / (n - 1)), and
        rho = r1 / (1 + r1), difference z until rho < 0.25 or d = dmax
        differences were taken (dmax = 2; 3 for the Hadamard estimators), and
@@ -128,6 +132,11 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
     estimator : {"adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev"}
         The deviation whose levels these are (it sets dmax, B1's sample
         size and where B1 stops).
+    from_frequency : bool, optional
+        The phase was integrated from frequency data: the lag-1 method removes
+        its line (their mean), as Stable32 removes the mean of frequency data.
+        Default False: phase data, whose line (a frequency offset) the method
+        sees, as Stable32.
 
     Returns
     -------
@@ -173,18 +182,25 @@ def identify_noise(phase: Any, factors: Any, estimator: str) -> np.ndarray:
         raise ValueError(f"factors must be in 1 .. {n - 1} (N = {n} phase points), got {short_repr(m.tolist())}")
     if not isinstance(estimator, str) or estimator.lower() not in NOISE_ID_ESTIMATORS:
         raise ValueError(f"estimator must be one of {list(NOISE_ID_ESTIMATORS)}, got {short_repr(estimator)}")
-    return phase_noise(np.ascontiguousarray(x), m, NOISE_ID_ESTIMATORS[estimator.lower()])
+    if not isinstance(from_frequency, (bool, np.bool_)):
+        raise TypeError(f"from_frequency must be True or False, got {short_repr(from_frequency)}")
+    return phase_noise(np.ascontiguousarray(x), m, NOISE_ID_ESTIMATORS[estimator.lower()],
+                       line=None if from_frequency else 0.0)
 
 
-def phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float = 0.0, line_free: bool = False) -> np.ndarray:
+def phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float = 0.0, line_free: bool = False,
+                line: float | None = None) -> np.ndarray:
     """:func:`identify_noise` without validation: ``x`` contiguous finite float64 phase, ``m`` int64 in 1 .. N - 1.
 
     ``drift``: ``x`` is the phase less ``drift * k (k - 1) / 2`` (a removed
     linear frequency drift); every method gets it back (Stable32 identifies the
     noise of the data as they are). ``line_free``: ``x`` has no large line (its
     mean frequency was removed), so R(n)'s running sum needs no conditioning.
+    ``line``: None for phase integrated from frequency data (the lag-1 method
+    removes a line); for phase data, ``x`` lacks ``line * k``, which the lag-1
+    method gets back (0.0: ``x`` is the phase as given).
     """
-    return _fill(_raw_phase_noise(x, m, dmax, drift, line_free), m)
+    return _fill(_raw_phase_noise(x, m, dmax, drift, line_free, line), m)
 
 
 def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int, drift: float,
@@ -238,12 +254,13 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
                     return running + drift * q * (q - 1.0) * (q - 2.0) / 6.0
 
                 alpha[i] = _rn_alpha(points_at, n, running_at, factor)
-    if undecided:
-        alpha[undecided] = _raw_phase_noise(phase(), m[undecided], dmax, drift, line_free=True)
+    if undecided:  # frequency data only: the lag-1 method removes the line
+        alpha[undecided] = _raw_phase_noise(phase(), m[undecided], dmax, drift, line_free=True, line=None)
     return _fill(alpha, m)
 
 
-def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line_free: bool) -> np.ndarray:
+def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line_free: bool,
+                     line: float | None) -> np.ndarray:
     """:func:`phase_noise` before the levels without an estimate are filled (NaN there)."""
     from avar._kernels.noise_id import lag1_levels, lag1_levels_split
 
@@ -253,7 +270,8 @@ def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line
     if acf.any():
         found = np.empty(int(acf.sum()))
         seen = x + drift * _triangular(np.arange(n, dtype=np.float64)) if drift else x  # the drift is data
-        (lag1_levels_split if found.size > 1 else lag1_levels)(seen, m[acf], int(dmax), found)
+        (lag1_levels_split if found.size > 1 else lag1_levels)(seen, m[acf], int(dmax),
+                                                               np.nan if line is None else float(line), found)
         alpha[acf] = found
     if not acf.all():
         lazy: dict[int, np.ndarray] = {}
@@ -290,7 +308,7 @@ def _triangular(k: np.ndarray) -> np.ndarray:
 
 
 def lag1_alpha(z: np.ndarray, dmax: int) -> float:
-    """alpha of detrended phase points z by the lag-1 autocorrelation (Riley and Greenhall 2004).
+    """alpha of phase points z by the lag-1 autocorrelation (Riley and Greenhall 2004), their mean removed.
 
     NaN for a constant series.
 

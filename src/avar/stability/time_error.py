@@ -111,15 +111,17 @@ def level_noise(fixed: int | None, values: np.ndarray, phase: np.ndarray, gaps: 
     """``alpha=`` at every level, or the noise identified as for OADEV (lag-1 autocorrelation, B1, R(n)).
 
     Gap-free data: on the phase less the line through its end points (B1 and
-    R(n) are blind to a frequency offset, the lag-1 method removes its own
-    quadratic), which spares the identification a least-squares fit.
+    R(n) are blind to a frequency offset; the lag-1 method removes its own line
+    for frequency data and gets the line back for phase data, as Stable32),
+    which spares the identification a least-squares fit.
     """
     if fixed is not None:
         return np.full(factors.size, fixed, dtype=np.int64)
     if gaps[-1]:
         return noise_exponents("oadev", values, data_type, rate, factors)
     ramp = np.linspace(phase[0], phase[-1], phase.size)
-    return _noise_of_levels("oadev", np.ascontiguousarray(phase - ramp), 0.0, factors)
+    slope = (phase[-1] - phase[0]) / (phase.size - 1) if data_type == "phase" else None  # phase data keep it
+    return _noise_of_levels("oadev", np.ascontiguousarray(phase - ramp), 0.0, factors, slope)
 
 
 def pdev_edf(alpha: np.ndarray, factors: np.ndarray, n_phase: int) -> np.ndarray:

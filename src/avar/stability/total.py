@@ -92,7 +92,7 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
     needed = _MIN_PHASE.get(estimator, 3) - (data_type == "freq")
     if values.size < needed:
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
-    x, _, scale, _, bad, _, _ = phase_parts(values, data_type, "ohdev" if estimator == "htotdev" else "oadev", scanned)
+    x, _, scale, _, bad, *_ = phase_parts(values, data_type, "ohdev" if estimator == "htotdev" else "oadev", scanned)
     bad = np.zeros(0, dtype=np.int64) if bad is None else np.ascontiguousarray(bad, dtype=np.int64)
     return values, rate, np.ascontiguousarray(x), bad, int(data_type == "freq"), scale, values.size + (data_type == "freq")
 
