@@ -52,7 +52,7 @@ _TABLE3 = np.array([(6.0, 4.0), (15.23, 12.0), (47.8, 40.0)])
 TOTDEV_EDF = {0: (1.500, 0.0), -1: (1.168, 0.22), -2: (0.927, 0.358)}
 #: What Stable32 adds to NIST SP 1065 Table 5's simple EDF where a total statistic takes it (TOTDEV at
 #: white and flicker PM, HTOTDEV below m = 16 and at PM). No source states it; Stable32's printed
-#: bounds imply it on four records (N = 1001, 1253, 55 688, 241 217 phase points; flicker PM, white,
+#: bounds imply it on four records (N = 1001, 1253, 55 688, 241 218 phase points; flicker PM, white,
 #: flicker and random-walk FM; EDF 18 to 1090): 2.00 +- 0.02 wherever the bounds resolve it.
 STABLE32_SIMPLE_EDF_OFFSET = 2.0
 

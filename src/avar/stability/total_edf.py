@@ -43,7 +43,7 @@ MTOT_EDF = {2: (1.90, 2.10), 1: (1.20, 1.40), 0: (1.10, 1.20), -1: (0.85, 0.50),
 #: at white FM, flicker PM and flicker FM, N the number of points given. No source states it; these
 #: are least-squares fits to the degrees of freedom its printed one-sigma bounds imply on two records
 #: (N = 1001 and 1253, given as phase and as frequency; 36, 7 and 8 rows), which they reproduce to
-#: 1.2e-4, 6e-5 and 5e-5 (3 units of the 5th printed digit at most). Flicker FM rests on one record.
+#: 6.9e-5, 6.2e-5 and 5.5e-5 (3 units of the 5th printed digit at most). Flicker FM rests on one record.
 STABLE32_MTOT_EDF = {0: (1.3313, 1.8927), 1: (1.7319, 2.9896), -1: (0.9204, 0.7596)}
 #: Below this factor MTOTDEV's (and TTOTDEV's) EDF is the modified Allan variance's, as
 #: Stable32's bounds show (PHASE.DAT: MDEV's EDF at m = 1 .. 8, a b N / m - c law from m = 10).
@@ -137,7 +137,7 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
     """EDF of a total or Theo statistic at every level, floored at 1.
 
     ``n_given``: the number of data points given (frequency data: N - 1), which
-    Stable32's MTOTVAR law takes for its N; default ``n_phase``.
+    Stable32's MTOTVAR and HTOTVAR rules take for their N; default ``n_phase``.
 
     * MTOTDEV, TTOTDEV: the modified Allan variance's (Greenhall) below m = 10,
       as Stable32; from m = 10 Stable32's b (N - 1) / m - c with (b, c) =
@@ -145,7 +145,7 @@ def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: i
       (0.9204, 0.7596) at flicker FM (:data:`STABLE32_MTOT_EDF`), NIST SP 1065
       Table 8's b N / m - c at white PM and random-walk FM. Stable32's law is
       published nowhere; fitted to the bounds it prints for two records of
-      different length (N = 1001 and 1253), it reproduces them to 1.2e-4, with
+      different length (N = 1001 and 1253), it reproduces them to 7e-5, with
       N the number of points given (its frequency and phase tables of one
       record differ so). Simulated records have 20 to 50 % fewer degrees of
       freedom (``benchmarks/total_edf_simulation.py``: white FM, N = 1001,
