@@ -41,7 +41,6 @@ def test_kernel_equals_the_numpy_twin(kind, dmax):
 def test_phase_data_keep_their_line(kind, dmax):
     # phase data: the kernel gets the line the caller removed back and takes only the mean off,
     # as the twin does with the decimated phase as given (no least-squares line)
-    decided = {}
     for seed in range(6):
         w = np.random.default_rng(seed).standard_normal(1200)
         given = {"white pm": w, "white fm": np.cumsum(w), "rw fm": np.cumsum(np.cumsum(w))}[kind]
@@ -49,10 +48,7 @@ def test_phase_data_keep_their_line(kind, dmax):
         slope = (given[-1] - given[0]) / 1199
         detrended = given - slope * np.arange(1200)
         for m in (1, 2, 5, 16, 40):
-            got = lag1_alpha_decimated(detrended, m, dmax, slope)
-            assert got == lag1_alpha(given[::m], dmax), (kind, seed, m)
-            decided[got] = decided.get(got, 0) + 1
-    assert len(decided) >= 1 and sum(decided.values()) == 30
+            assert lag1_alpha_decimated(detrended, m, dmax, slope) == lag1_alpha(given[::m], dmax), (kind, seed, m)
 
 
 def test_a_large_frequency_offset_of_phase_data_keeps_its_digits():
@@ -63,9 +59,6 @@ def test_a_large_frequency_offset_of_phase_data_keeps_its_digits():
         for noise, alpha in ((w, 2.0), (np.cumsum(w), 0.0)):
             assert lag1_alpha_decimated(noise, 1, 2, 1e12) == alpha
             assert lag1_alpha_decimated(noise, 1, 2, 0.0) == alpha  # no offset: order 0 decides the same
-    # the line matters at order 0 where the noise alone would stop there: white PM with a moderate offset
-    w = np.random.default_rng(9).standard_normal(3000)
-    assert lag1_alpha_decimated(w, 1, 2, 0.0) == 2.0 and lag1_alpha(w + 0.01 * np.arange(3000), 2) == 2.0
 
 
 def test_constant_series_gives_nan():
