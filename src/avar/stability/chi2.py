@@ -30,6 +30,7 @@ and the noise report use the exact ones. Either set is one call away:
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -38,10 +39,9 @@ from avar._validation import short_repr
 
 #: One standard deviation, erf(1 / sqrt(2)) = 0.682689...: the default confidence. Stable32 prints
 #: it as "Confidence Factor = 0.683" and computes with the exact value: its printed bounds are
-#: reproduced with this, not with 0.683, whose intervals are as wide as one sigma's with 0.15 % fewer
-#: degrees of freedom
-#: (``tests/stability/test_chi2.py``).
-ONE_SIGMA = 0.6826894921370859
+#: reproduced with this, not with 0.683, whose intervals are as wide as one sigma's with 0.15 %
+#: fewer degrees of freedom (``tests/stability/test_chi2.py``).
+ONE_SIGMA = math.erf(1.0 / math.sqrt(2.0))
 DEFAULT_CONFIDENCE = ONE_SIGMA
 QUANTILES = ("exact", "stable32")
 #: The quantiles of the deviation catalogue's bounds: Stable32's, to print what it prints.

@@ -148,8 +148,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     if bias_correction:
         bias = totvar_bias(alpha, factors, values.size)  # T = the record's count of points, as Stable32
         variance, deviation = variance / bias, deviation / np.sqrt(bias)
-    # Stable32's TOTVAR T / tau counts the points given (frequency data: one fewer than the phase)
-    edf = estimator_edf(estimator, alpha, factors, values.size if estimator == "totdev" else n_phase)
+    edf = estimator_edf(estimator, alpha, factors, n_phase, n_given=values.size)
     if n_missing:
         edf = gap_scaled_edf(edf, n, estimator, n_phase, factors)
     lci, uci = chi2_bounds(deviation, edf, float(confidence), quantiles=CATALOGUE_QUANTILES)

@@ -294,7 +294,8 @@ def stable32_simple_edf(n_phase: float, m: np.ndarray, alpha: np.ndarray) -> np.
     return simple_edf(n_phase, m, alpha) + STABLE32_SIMPLE_EDF_OFFSET
 
 
-def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: int) -> np.ndarray:
+def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: int,
+                  n_given: int | None = None) -> np.ndarray:
     """EDF of a named stability estimator at every level.
 
     ``"adev"`` (d = 2, non-overlapping), ``"oadev"`` (d = 2, overlapping),
@@ -312,6 +313,9 @@ def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phas
         Averaging factors m per level.
     n_phase : int
         Number of phase points (frequency data of N values: N + 1).
+    n_given : int, optional
+        Number of data points given (frequency data: ``n_phase - 1``), which
+        TOTDEV's EDF counts, as Stable32; default ``n_phase``.
 
     Returns
     -------
@@ -321,8 +325,8 @@ def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phas
     --------
     >>> estimator_edf("oadev", [0, 0], [1, 4], 1001).round(2)
     array([782.03, 306.09])
-    >>> estimator_edf("totdev", [0], [4], 1001)
-    array([375.375])
+    >>> estimator_edf("totdev", [0], [4], 1001), estimator_edf("totdev", [0], [4], 1001, n_given=1000)
+    (array([375.375]), array([375.]))
     """
     if not isinstance(estimator, str) or estimator.lower() not in EDF_ESTIMATORS:
         raise ValueError(f"estimator must be one of {list(EDF_ESTIMATORS)}, got {short_repr(estimator)}")
@@ -331,7 +335,7 @@ def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phas
     if ((alpha < -2) | (alpha > 2)).any():
         raise ValueError(f"alpha must hold integers in -2 .. 2, got {short_repr(np.unique(alpha).tolist())}")
     if estimator == "totdev":
-        return totdev_edf(n_phase, factors, alpha)
+        return totdev_edf(n_phase if n_given is None else n_given, factors, alpha)
     d, overlapping, modified = ESTIMATORS[estimator]
     return greenhall_edf(alpha, d, factors, n_phase, overlapping=overlapping, modified=modified)
 

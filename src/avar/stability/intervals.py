@@ -23,8 +23,9 @@ def relative_errors(n: int, factors: np.ndarray) -> np.ndarray:
 def check_ci(ci: Any, confidence: Any) -> tuple[str, float | None]:
     """Validate ``avar()``'s ``ci`` and ``confidence``; the confidence defaults to one sigma for "chi2".
 
-    >>> check_ci("chi2", None), check_ci("r", None)
-    (('chi2', 0.6826894921370859), ('r', None))
+    >>> (ci, level), r_band = check_ci("chi2", None), check_ci("r", None)
+    >>> ci, round(level, 4), r_band
+    ('chi2', 0.6827, ('r', None))
     """
     if not isinstance(ci, str) or ci.lower() not in CI_KINDS:
         raise ValueError(f"ci must be 'r' (R's band adev (1 -/+ 2 errors)) or 'chi2' (chi-squared band "
