@@ -13,7 +13,6 @@ cores. ``pytest -n 0`` runs it in one process.
 import importlib.util
 import os
 import sys
-from pathlib import Path
 
 import pytest
 
@@ -26,9 +25,6 @@ _APPROX_SCALAR = type(pytest.approx(1.0))  # pytest's class; its module moved be
 _APPROX_SCALAR.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
 if 1e-15 == pytest.approx(2e-15, rel=1e-6):  # a pytest that reads its tolerance elsewhere: say so
     raise RuntimeError("conftest.py could not make pytest.approx relative; check DEFAULT_ABSOLUTE_TOLERANCE")
-
-# Shared test helpers (tests/reference.py) import as top-level modules.
-sys.path.insert(0, str(Path(__file__).resolve().parent / "tests"))
 
 #: What ``pip install ".[test]"`` brings that every test module needs (import name: package).
 REQUIRED = {"numpy": "numpy", "scipy": "scipy", "pandas": "pandas", "matplotlib": "matplotlib",

@@ -43,8 +43,8 @@ import numpy as np
 from timing import median_time  # benchmarks/timing.py
 
 import avar
-from avar._kernels.streaming import plain_squares  # the library's plain float64 level sum
-from avar.stability.grids import averaging_factors
+from avar._kernels.allan.blocks import plain_squares  # the library's plain float64 level sum
+from avar.stability.shared.grids import averaging_factors
 
 try:
     import allantools

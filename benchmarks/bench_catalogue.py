@@ -97,7 +97,7 @@ def bench_stream(quick: bool) -> None:
 def bench_power_law(quick: bool) -> None:
     """Coverage of theory by the 95 % bands of OADEV of generated noise (alpha fixed to the truth)."""
     from avar.models.noise import discrete_psd
-    from avar.stability.edf import chi2_bounds, estimator_edf
+    from avar.stability.uncertainty.edf import chi2_bounds, estimator_edf
 
     n, seeds = (2**14, 20) if quick else (2**17, 50)
     f = np.geomspace(1e-9, 0.5, 400001)
@@ -118,7 +118,7 @@ def bench_power_law(quick: bool) -> None:
 
 def bench_pdev_edf(quick: bool) -> None:
     """Empirical EDF of PDEV (2 mean**2 / variance over simulated series) against the one used for its bounds."""
-    from avar.stability.time_error import pdev_edf
+    from avar.stability.time_error.deviations import pdev_edf
 
     n, seeds = 1024, (100 if quick else 300)
     factors = 2 ** np.arange(0, 8)

@@ -26,7 +26,7 @@ import json, resource, sys, time
 import numpy as np
 import dask.array as da
 import avar
-from avar.stability import dask_backend
+from avar.stability.allan import dask as dask_backend
 
 n, chunks, taus, mode = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], sys.argv[4]
 x = np.random.default_rng(1).standard_normal(n)

@@ -13,7 +13,7 @@ once per call (allantools is O(N^2) Python: 10 s for MTOTDEV at N = 3e3) up
 to ``--peer-max`` points, and ours alone beyond (ThêoH has no peer); wall and
 CPU time (the CPU time counts every thread). MTOTDEV, TTOTDEV and HTOTDEV are
 also timed in the same run by the direct O(N m) loop they used before the
-blocked O(N) expansion (:mod:`avar._kernels.total_blocks`), with the largest
+blocked O(N) expansion (:mod:`avar._kernels.total.blocks`), with the largest
 relative difference of the two results; above ``--loop-max`` points the loop is
 not run and its time is extrapolated from the largest N timed by the octave sum
 of (N - 3m + 1) m (marked ``~``).
@@ -27,7 +27,7 @@ our averaging times, so both compute the same levels). Columns:
   B1 and R(n), ``allantools.ci.b1``/``rn`` and their boundaries, where fewer
   than 30 points remain and ``autocorr_noise_id`` raises), ``edf_greenhall``
   (``edf_totdev`` for totdev) and ``confidence_interval`` (at our 0.683);
-* ``core``: :func:`avar.stability.deviation_core.deviation_levels` alone
+* ``core``: :func:`avar.stability.classic.core.deviation_levels` alone
   (variances and term counts: what the plain allantools call computes);
 * ``avar``: the public function (validation, variances, noise
   identification, EDF and chi-squared bounds).
@@ -52,8 +52,8 @@ import numpy as np
 from timing import median_time  # benchmarks/timing.py
 
 import avar
-from avar.stability.deviation_core import deviation_levels
-from avar.stability.deviation_grids import ESTIMATORS, deviation_factors
+from avar.stability.classic.core import deviation_levels
+from avar.stability.shared.deviation_grids import ESTIMATORS, deviation_factors
 
 try:
     import allantools
@@ -125,7 +125,7 @@ LOOPS = ("mtotdev", "ttotdev", "htotdev")
 @contextlib.contextmanager
 def direct_loop():
     """MTOTDEV, TTOTDEV and HTOTDEV by the direct O(N m) loop (the path before the expansion)."""
-    from avar._kernels import total
+    from avar._kernels.total import windows as total
 
     saved = total.FAST_WORK
     total.FAST_WORK = 1 << 62

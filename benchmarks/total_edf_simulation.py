@@ -5,7 +5,7 @@ phase noise (Kasdin and Walter, exact spectrum, ``avar.models.noise.power_law``)
 of N = 1001 points, the size of Stable32's PHASE.DAT, this script estimates it per
 level and prints it next to:
 
-* ``avar``: what avar uses (:func:`avar.stability.total_edf.total_edf`), which is
+* ``avar``: what avar uses (:func:`avar.stability.uncertainty.total_edf.total_edf`), which is
   Stable32 1.60's: its printed one-sigma bounds of PHASE.DAT and of a 1253-point
   clock record are reproduced to 1e-4 (``tests/stability/test_total_theo.py``). For
   MTOTVAR from m = 10 that is b (N - 1) / m - c, (b, c) = (1.3313, 1.8927) at white
@@ -44,7 +44,7 @@ import numpy as np
 
 import avar
 from avar.models.noise import power_law
-from avar.stability.total_edf import MTOT_EDF, MTOT_EDF_FROM, total_edf
+from avar.stability.uncertainty.total_edf import MTOT_EDF, MTOT_EDF_FROM, total_edf
 
 N_PHASE = 1001
 LEVELS = {"mtotdev": [1, 4, 10, 16, 32, 64, 128, 256], "htotdev": [2, 4, 8, 16, 32, 64, 128, 256]}

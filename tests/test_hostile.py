@@ -19,8 +19,8 @@ import pandas as pd
 import pytest
 
 import avar
-from avar.stability.results import AllanVariance
-from tests.cli_runner import cli
+from avar.stability.allan.results import AllanVariance
+from tests._support.cli_runner import cli
 
 FMAX = np.finfo(np.float64).max
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

@@ -9,9 +9,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import avar
-import avar.stability.allan as estimation_module
+import avar.stability.allan.estimator as estimation_module
 from avar.imu import IMU
-from avar.stability.results import AllanVariance, ImuAllanVariance
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 
 GYRO, ACCEL = "Gyroscope", "Accelerometer"
 R_NAMES = ("Gyro. X", "Gyro. Y", "Gyro. Z", "Accel. X", "Accel. Y", "Accel. Z")

@@ -309,7 +309,7 @@ def native_values(array: np.ndarray) -> np.ndarray | None:
     """``array`` itself when the kernels read it as it is, else None: integers, booleans, float32/64
     (magnitudes near the float64 limit are the kernels' to rescale). A non-finite value is not looked
     for here: it makes the kernels' centre, hence every level, non-finite, and
-    :func:`avar.stability.columns.allan_variance_columns` then reports it (:func:`check_finite`),
+    :func:`avar.stability.allan.columns.allan_variance_columns` then reports it (:func:`check_finite`),
     so valid data is read once less."""
     if array.dtype.kind in "biu" or (array.dtype.kind == "f" and array.itemsize >= 4):
         return array

@@ -12,7 +12,7 @@ import pytest
 distributed = pytest.importorskip("dask.distributed")
 
 from avar.cli import compute_many  # noqa: E402
-from tests.cli_runner import cli  # noqa: E402
+from tests._support.cli_runner import cli  # noqa: E402
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -9,11 +9,11 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
-from cli_runner import cli
 
 import avar
 from avar.cli.demo import MARK_KEY, is_own_figure, png_text
 from avar.models import RW, WN
+from tests._support.cli_runner import cli
 
 FREQ = 50.0
 N = 20_000

@@ -7,8 +7,8 @@ import pandas as pd
 import pytest
 
 import avar
-from avar.stability.statistics import DEVIATION_STATISTICS
-from tests.cli_runner import cli
+from avar.stability.shared.registry import DEVIATION_STATISTICS
+from tests._support.cli_runner import cli
 
 
 @pytest.fixture()

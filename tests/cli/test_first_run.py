@@ -15,7 +15,7 @@ import pytest
 from numba import njit
 
 import avar
-from avar._kernels.cache_dir import choose_cache_dir, configure, user_cache_dir, writable
+from avar._kernels.runtime.cache import choose_cache_dir, configure, user_cache_dir, writable
 from avar.cli.first_run import compile_notice, notice_text
 
 SRC = Path(avar.__file__).resolve().parent.parent
@@ -52,8 +52,8 @@ def test_cold_cache_says_it_once_and_warm_cache_never(tmp_path):
     cache = tmp_path / "numba-cache"
     environment = _environment(NUMBA_CACHE_DIR=str(cache))
     command = [sys.executable, "-m", "avar", "compute", str(log), "--output", "-"]
-    probe = [sys.executable, "-c", "from avar._kernels.cache_dir import cached_for_this_machine as c; "
-             "from avar._kernels.small import small_allan_variance as k; print(c(k))"]
+    probe = [sys.executable, "-c", "from avar._kernels.runtime.cache import cached_for_this_machine as c; "
+             "from avar._kernels.allan.small import small_allan_variance as k; print(c(k))"]
     assert subprocess.run(probe, env=environment, capture_output=True, text=True).stdout.strip() == "False"
     cold = subprocess.run(command, env=environment, capture_output=True, text=True, timeout=600)
     assert cold.returncode == 0, cold.stderr
@@ -90,6 +90,16 @@ def test_a_folder_whose_cache_cannot_be_created_is_not_writable(tmp_path):
     assert environ["NUMBA_CACHE_DIR"] == str(tmp_path / "xdg" / "avar" / "numba")
 
 
+def test_a_kernel_subpackage_whose_cache_cannot_be_created_makes_the_package_unwritable(tmp_path):
+    """The kernels live in a folder per family: numba writes beside each of them."""
+    (tmp_path / "allan").mkdir()
+    (tmp_path / "allan" / "__init__.py").write_text("")
+    assert writable(tmp_path)
+    (tmp_path / "allan" / "__pycache__").rmdir()
+    (tmp_path / "allan" / "__pycache__").write_text("not a folder")
+    assert not writable(tmp_path)
+
+
 @pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() == 0, reason="root writes into read-only folders")
 def test_a_read_only_folder_is_not_writable(tmp_path):
     folder = tmp_path / "ro"
@@ -107,7 +117,7 @@ def test_an_unwritable_package_caches_its_kernels_in_the_user_cache(tmp_path):
     shutil.copytree(SRC / "avar", copy / "avar", ignore=shutil.ignore_patterns("__pycache__"))
     (copy / "avar" / "_kernels" / "__pycache__").write_text("not a folder")
     environment = _environment(PYTHONPATH=str(copy), XDG_CACHE_HOME=str(tmp_path / "xdg"))
-    code = ("import os, avar._kernels; from avar._kernels.small import small_allan_variance as k; "
+    code = ("import os, avar._kernels; from avar._kernels.allan.small import small_allan_variance as k; "
             "print(avar._kernels.__file__); print(os.environ.get('NUMBA_CACHE_DIR')); print(k._cache._cache_path)")
     lines = subprocess.run([sys.executable, "-c", code], env=environment, capture_output=True, text=True,
                            check=True).stdout.splitlines()

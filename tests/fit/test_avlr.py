@@ -21,10 +21,10 @@ from avar.fit.slopes import (
     per_sample_process,
 )
 from avar.models import DR, QN, RW, WN
-from avar.stability.allan import avar
-from avar.stability.grids import averaging_factors, n_differences
-from avar.stability.intervals import relative_errors
-from avar.stability.results import AllanVariance, ImuAllanVariance
+from avar.stability.allan.estimator import avar
+from avar.stability.allan.intervals import relative_errors
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance
+from avar.stability.shared.grids import averaging_factors, n_differences
 
 # The package re-exports the function avlr under the name of its submodule.
 bootstrap_module = importlib.import_module("avar.fit.bootstrap")

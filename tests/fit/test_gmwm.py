@@ -14,7 +14,7 @@ from avar.fit.gmwm import gmwm, octave_factors
 from avar.fit.gmwm.results import GmwmResult, ImuGmwmResult
 from avar.imu import IMU
 from avar.models import AR1, DR, QN, RW, WN, Process
-from avar.stability.results import AllanVariance
+from avar.stability.allan.results import AllanVariance
 
 N = 20_000  # exact-theory tests: the weights='full' bootstrap simulates 200 series of N
 

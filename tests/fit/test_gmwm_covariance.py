@@ -8,7 +8,7 @@ import pytest
 from avar.fit.gmwm import gmwm, octave_factors
 from avar.fit.gmwm.covariance import increment_autocovariance, mo_av_covariance
 from avar.models import AR1, DR, FN, QN, RW, WN
-from avar.stability.results import AllanVariance
+from avar.stability.allan.results import AllanVariance
 
 MODELS = [
     WN(sigma2=1.3) + RW(gamma2=0.2),

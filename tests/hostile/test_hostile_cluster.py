@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 import avar
-from tests.cli_runner import cli
+from tests._support.cli_runner import cli
 
 pytest.importorskip("dask.distributed")
 

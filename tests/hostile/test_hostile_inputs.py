@@ -11,8 +11,8 @@ import pandas as pd
 import pytest
 
 import avar
-from avar.stability.statistics import DEVIATION_STATISTICS
-from tests.cli_runner import cli
+from avar.stability.shared.registry import DEVIATION_STATISTICS
+from tests._support.cli_runner import cli
 
 RNG = np.random.default_rng(2027)
 X = RNG.standard_normal(3000)
@@ -213,7 +213,7 @@ def test_dask_many_chunks_equal_numpy():
 
 def test_dask_unknown_chunks_all_taus_and_huge_values(monkeypatch):
     da = pytest.importorskip("dask.array")
-    from avar.stability import dask_backend
+    from avar.stability.allan import dask as dask_backend
 
     x = np.random.default_rng(6).standard_normal(5000)
     unknown = da.from_array(x, chunks=500)
@@ -233,7 +233,7 @@ def test_lost_workers_end_in_one_line():
     distributed = pytest.importorskip("dask.distributed")
     import os
 
-    from avar.stability.dask_backend import WorkerLost, map_on_cluster
+    from avar.stability.allan.dask import WorkerLost, map_on_cluster
 
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0",
                                   silence_logs=50) as cluster, distributed.Client(cluster) as client:

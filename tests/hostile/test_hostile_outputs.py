@@ -19,7 +19,7 @@ import pytest
 
 import avar
 from avar.cli import outputs
-from tests.cli_runner import cli
+from tests._support.cli_runner import cli
 
 X = np.random.default_rng(27).standard_normal(2048)
 

@@ -19,8 +19,8 @@ import pandas as pd
 import pytest
 
 from avar.io import datasets
-from avar.stability.grids import n_differences
-from avar.stability.results import AllanVariance, ImuAllanVariance
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance
+from avar.stability.shared.grids import n_differences
 
 GYRO, ACCEL = "Gyroscope", "Accelerometer"
 REPOSITORY = Path(__file__).resolve().parents[2]

@@ -10,7 +10,7 @@ import pytest
 
 from avar.models import FN, RW, WN
 from avar.models.flicker import FLICKER_AV_FACTOR, av_fn
-from avar.stability.columns import allan_variance_columns
+from avar.stability.allan.columns import allan_variance_columns
 
 
 def reference_av(b2, m):

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from avar.models import AR1, DR, QN, RW, WN, CompositeModel
-from avar.stability.columns import allan_variance_columns
-from avar.stability.grids import averaging_factors
+from avar.stability.allan.columns import allan_variance_columns
+from avar.stability.shared.grids import averaging_factors
 
 
 # Closed forms written out here (not taken from avar.theory) so that a wrong

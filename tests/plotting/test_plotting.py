@@ -19,7 +19,7 @@ from avar.imu import IMU
 from avar.io import datasets
 from avar.models import RW, WN
 from avar.plotting import plot_avar, plot_avlr, plot_compare, plot_imu_avar, plot_imu_avlr
-from avar.stability.results import ImuAllanVariance
+from avar.stability.allan.results import ImuAllanVariance
 
 N = 4096  # octave grid m = 2 .. 2048 = N / 2: the last level has lci < 0
 

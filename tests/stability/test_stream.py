@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import avar
-from avar.stability.edf import estimator_edf
+from avar.stability.uncertainty.edf import estimator_edf
 
 STATISTICS = ["oadev", "adev", "mdev", "tdev", "hdev", "ohdev"]
 

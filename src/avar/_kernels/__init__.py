@@ -4,28 +4,28 @@ Nothing here validates input or builds objects: the public functions
 validate once at the boundary and call these kernels on clean arrays. The
 tests check every kernel against a plain NumPy transcription.
 
-* :mod:`avar._kernels.allan`: compensated cumulative sums held in memory and
+* :mod:`avar._kernels.classic.sums`: compensated cumulative sums held in memory and
   squared second differences per level (the deviation family's kernels).
-* :mod:`avar._kernels.columns`: the plain-array entry point of the Allan
+* :mod:`avar._kernels.allan.columns`: the plain-array entry point of the Allan
   variance, :func:`allan_variance_columns` (any real dtype, read in place in
   blocks, a small workspace instead of O(N) arrays). It dispatches to
-  :mod:`avar._kernels.small` (short series: one call, one thread),
-  :mod:`avar._kernels.haar` (octave "to": the Haar pyramid, one read),
-  :mod:`avar._kernels.sweep` and :mod:`avar._kernels.far` (octave "mo":
+  :mod:`avar._kernels.allan.small` (short series: one call, one thread),
+  :mod:`avar._kernels.allan.haar` (octave "to": the Haar pyramid, one read),
+  :mod:`avar._kernels.allan.sweep` and :mod:`avar._kernels.allan.far` (octave "mo":
   a cache-blocked sweep of the small levels, the large ones by residue
-  class) or :mod:`avar._kernels.levels` (any other grid, level by level),
-  all on the primitives of :mod:`avar._kernels.streaming`.
-* :mod:`avar._kernels.covariance`: the theoretical Allan variance of a
+  class) or :mod:`avar._kernels.allan.levels` (any other grid, level by level),
+  all on the primitives of :mod:`avar._kernels.allan.blocks`.
+* :mod:`avar._kernels.models.covariance`: the theoretical Allan variance of a
   covariance matrix (one validating pass, then O(n) per scale).
 * :mod:`avar._kernels.robust`: residuals from interpolation and the running median (outliers).
-* :mod:`avar._kernels.simulation`: recursions of the simulated processes.
-* :mod:`avar._kernels.cache_dir`: where numba's cache goes (the user's cache
+* :mod:`avar._kernels.models.simulation`: recursions of the simulated processes.
+* :mod:`avar._kernels.runtime.cache`: where numba's cache goes (the user's cache
   directory when the package folder is not writable).
 """
 
 import os
 
-from avar._kernels.cache_dir import configure as _configure_cache
+from avar._kernels.runtime.cache import configure as _configure_cache
 
 # Before numba loads: a read-only package keeps its compiled kernels in the user's cache.
 _configure_cache()
@@ -38,7 +38,8 @@ _configure_cache()
 if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
     os.environ["GOMP_SPINCOUNT"] = "1000"
 
-from avar._kernels.allan import (  # noqa: E402
+from avar._kernels.allan.columns import allan_variance_columns as streaming_allan_variance  # noqa: E402
+from avar._kernels.classic.sums import (  # noqa: E402
     BLOCK,
     CHUNK,
     CUMSUM_BLOCK,
@@ -49,12 +50,11 @@ from avar._kernels.allan import (  # noqa: E402
     squared_difference_sums,
     task_sums,
 )
-from avar._kernels.columns import allan_variance_columns as streaming_allan_variance  # noqa: E402
-from avar._kernels.covariance import COV_TILE, NOAV_SCAN_RATIO, covariance_pass, moav_from_sums  # noqa: E402
+from avar._kernels.models.covariance import COV_TILE, NOAV_SCAN_RATIO, covariance_pass, moav_from_sums  # noqa: E402
+from avar._kernels.models.simulation import ar1_recursion  # noqa: E402
 from avar._kernels.robust import (  # noqa: E402
     intact_squares,
     interpolation_residuals,
     release_candidates,
     running_median,
 )
-from avar._kernels.simulation import ar1_recursion  # noqa: E402

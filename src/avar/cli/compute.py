@@ -50,9 +50,9 @@ def _warm_up() -> None:
     """
     import numpy as np
 
-    from avar._kernels.cache_dir import cached_for_this_machine
-    from avar._kernels.small import small_allan_variance
-    from avar.stability.allan import avar
+    from avar._kernels.allan.small import small_allan_variance
+    from avar._kernels.runtime.cache import cached_for_this_machine
+    from avar.stability.allan.estimator import avar
 
     if cached_for_this_machine(small_allan_variance):
         x = np.arange(8.0)

@@ -6,7 +6,7 @@ and :func:`allan_of`, with the tables and figures of a result. Every file is rea
 and computed by :func:`compute_file`, the same reader and the same estimator.
 Without ``--workers``/``--scheduler`` the files run one after the other in this
 process; with them, one task per file on a
-``dask.distributed`` cluster (:func:`avar.stability.dask_backend.map_on_cluster`): a
+``dask.distributed`` cluster (:func:`avar.stability.allan.dask.map_on_cluster`): a
 ``LocalCluster`` of N single-threaded worker processes, or the scheduler at ADDRESS.
 A worker sends back only the small result of its file (per channel: taus, cluster
 sizes, Allan variances, errors and terms per level, name), from which this process
@@ -131,7 +131,7 @@ def load(path: str, options: ReadOptions, progress: bool | None = None) -> tuple
 def allan_of(data: Any, type: str, taus: str, names: Iterable[str] | None = None):
     """The Allan variance of an IMU, or of every column of a Recording (a dict by column name)."""
     from avar.imu import IMU
-    from avar.stability.allan import avar
+    from avar.stability.allan.estimator import avar
 
     if isinstance(data, IMU):
         return avar(data, type=type, taus=taus)
@@ -176,7 +176,7 @@ def pack(results: Any) -> dict[str, Any]:
 
 def unpack(packed: dict[str, Any]) -> Any:
     """The result objects :func:`pack` was given, rebuilt (and validated) by their constructors."""
-    from avar.stability.results import AllanVariance, ImuAllanVariance
+    from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 
     if "series" in packed:
         return {name: AllanVariance(**values) for name, values in packed["series"].items()}
@@ -210,7 +210,7 @@ def compute_files(
             items = tqdm(paths, desc="computing", unit="file", file=sys.stderr)
         packed = [compute_file(path, options) for path in items]
     else:
-        from avar.stability.dask_backend import WorkerLost, map_on_cluster
+        from avar.stability.allan.dask import WorkerLost, map_on_cluster
 
         try:
             packed = map_on_cluster(compute_file, paths, options, scheduler=scheduler, workers=workers or 1,

@@ -61,7 +61,7 @@ def simulate_demo_series(n: int = DEMO_N, seed: int = 2024) -> np.ndarray:
 
 def run(args: argparse.Namespace) -> int:
     from avar.fit.avlr import avlr
-    from avar.stability.allan import avar
+    from avar.stability.allan.estimator import avar
 
     out = Path(args.out)
     if out.exists() and not out.is_dir():

@@ -2,7 +2,7 @@
 
 Every ``--stat NAME`` is looked up by name among the public deviation
 functions of ``avar`` (``getattr(avar, NAME)``); the accepted names are the
-registry :data:`avar.stability.statistics.DEVIATION_STATISTICS`, so a new
+registry :data:`avar.stability.shared.registry.DEVIATION_STATISTICS`, so a new
 statistic needs no change here.
 """
 
@@ -15,8 +15,8 @@ import pandas as pd
 
 from avar.cli.common import Progress, UsageError
 from avar.cli.outputs import plan_outputs, report
-from avar.stability.chi2 import DEFAULT_CONFIDENCE
-from avar.stability.statistics import DEVIATION_STATISTICS
+from avar.stability.shared.registry import DEVIATION_STATISTICS
+from avar.stability.uncertainty.chi2 import DEFAULT_CONFIDENCE
 
 #: Columns of the printed table, as Stable32's run table.
 TABLE_COLUMNS = ["AF", "Tau", "#", "Alpha", "Min Sigma", "Sigma", "Max Sigma"]

@@ -1,7 +1,7 @@
 """The first run's notice: numba compiles the kernels once per machine, and the command says so.
 
 The kernels are compiled on first use and stored in numba's cache (see
-:mod:`avar._kernels.cache_dir`); later runs load them in milliseconds. A cold cache
+:mod:`avar._kernels.runtime.cache`); later runs load them in milliseconds. A cold cache
 makes the first run several times slower, which a user would otherwise take for a
 hang. The notice is printed once, on stderr, when numba actually starts compiling:
 numba announces a ``"numba:compile"`` event exactly when a kernel is not found in its

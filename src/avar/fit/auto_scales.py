@@ -34,8 +34,8 @@ import numpy as np
 
 from avar._frozen import frozen_array, frozen_mapping
 from avar.fit.noise_fit import TERM_SLOPES, TERMS, TermFit, fit_noise_terms
-from avar.stability.allan import avar as allan_variance
-from avar.stability.results import AllanVariance
+from avar.stability.allan.estimator import avar as allan_variance
+from avar.stability.allan.results import AllanVariance
 
 __all__ = ["AutoScales", "auto_scales", "level_edf", "local_slopes"]
 

@@ -21,8 +21,8 @@ from avar.fit.results import SUFFIXES, AvlrResult, ImuAvlrResult
 from avar.fit.slopes import PROCESSES, check_scale_selections, fit_slopes, implied_allan_deviation, per_sample_model
 from avar.imu import ACCELEROMETER, GYROSCOPE, IMU
 from avar.models import NoiseModel
-from avar.stability.allan import avar as allan_variance
-from avar.stability.results import AllanVariance, ImuAllanVariance
+from avar.stability.allan.estimator import avar as allan_variance
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 
 __all__ = ["avlr", "fit_channels", "ChannelFit"]
 

@@ -17,8 +17,8 @@ import pandas as pd
 
 from avar.fit.slopes import log_mean_estimate
 from avar.models import NoiseModel
-from avar.stability.columns import allan_variance_columns
-from avar.stability.results import AllanVariance
+from avar.stability.allan.columns import allan_variance_columns
+from avar.stability.allan.results import AllanVariance
 
 #: Bootstrap samples per chunk of replicates: ~28 bytes each (series, scratch and the
 #: compensated cumulative sums) bound the memory to about 1 GB whatever B and N.

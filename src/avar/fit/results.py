@@ -17,7 +17,7 @@ from avar._frozen import frozen_array, frozen_frame, frozen_mapping, frozen_seri
 from avar.fit.slopes import format_scales, parameter_label
 from avar.imu import ACCELEROMETER, GYROSCOPE
 from avar.models import NoiseModel
-from avar.stability.results import AllanVariance, ImuAllanVariance, format_frequency
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance, format_frequency
 
 __all__ = ["AvlrResult", "ImuAvlrResult"]
 

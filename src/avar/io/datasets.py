@@ -30,8 +30,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar.stability.grids import check_type, n_differences
-from avar.stability.results import AllanVariance, ImuAllanVariance
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance
+from avar.stability.shared.grids import check_type, n_differences
 
 #: Directory of the ``<name>.npz`` files, inside the package ``avar.io``.
 DATA_DIRECTORY = "data"

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from avar.models.theory import _as_nonnegative, _as_phi, _as_whole
+from avar.models.arguments import as_nonnegative, as_phi, as_whole
 
 __all__ = ["covmat_ar1blocks", "covmat_bi", "covmat_nswn"]
 
@@ -29,7 +29,7 @@ def _check_sizes(**sizes: Any) -> list[int]:
     for name, val in sizes.items():
         if np.ndim(val) != 0:
             raise ValueError(f"{name} must be a single whole number, got shape {np.shape(val)}")
-        out.append(int(_as_whole(val, name)))
+        out.append(int(as_whole(val, name)))
     if len(out) == 2 and out[1] > out[0]:
         raise ValueError(f"n_block must be <= n_total, got n_block={out[1]} > n_total={out[0]}")
     return out
@@ -79,8 +79,8 @@ def covmat_ar1blocks(n_total: Any, n_block: Any, phi: Any, sigma2: Any) -> np.nd
            [0. , 0. , 0.5, 1. ]])
     """
     nt, nb = _check_sizes(n_total=n_total, n_block=n_block)
-    p = _scalar(_as_phi(phi), "phi")
-    s2 = _scalar(_as_nonnegative(sigma2, "sigma2"), "sigma2")
+    p = _scalar(as_phi(phi), "phi")
+    s2 = _scalar(as_nonnegative(sigma2, "sigma2"), "sigma2")
     lag = np.abs(np.subtract.outer(np.arange(nb), np.arange(nb))).astype(np.float64)
     return np.kron(np.eye(nt // nb), s2 / (1.0 - p * p) * p**lag)
 
@@ -121,7 +121,7 @@ def covmat_bi(sigma2: Any, n_total: Any, n_block: Any) -> np.ndarray:
            [0., 0., 2., 2.],
            [0., 0., 2., 2.]])
     """
-    s2 = _scalar(_as_nonnegative(sigma2, "sigma2"), "sigma2")
+    s2 = _scalar(as_nonnegative(sigma2, "sigma2"), "sigma2")
     nt, nb = _check_sizes(n_total=n_total, n_block=n_block)
     return np.kron(np.eye(nt // nb), np.full((nb, nb), s2))
 
@@ -164,7 +164,7 @@ def covmat_nswn(sigma2: Any, n_total: Any) -> np.ndarray:
            [0. , 1. , 0. ],
            [0. , 0. , 1.5]])
     """
-    s2 = _as_nonnegative(sigma2, "sigma2")
+    s2 = as_nonnegative(sigma2, "sigma2")
     (nt,) = _check_sizes(n_total=n_total)
     if s2.ndim == 0:
         return float(s2) * np.eye(nt)

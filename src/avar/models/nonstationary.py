@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 
 from avar import _kernels
-from avar.models.theory import _as_whole
+from avar.models.arguments import as_whole
 
 __all__ = ["moav", "noav"]
 
@@ -106,7 +106,7 @@ def _prepare(n: Any, covmat: Any, kind: str) -> tuple[np.ndarray, np.ndarray, np
     """``(c, m, ks)``: covmat (shape-checked), the scales as given, the distinct scales."""
     c = _as_covmat(covmat)
     try:
-        m = _as_whole(n, "n")
+        m = as_whole(n, "n")
         big = 2 * m > c.shape[0]
         if big.any():
             raise ValueError(f"n must satisfy 1 <= n <= T/2 = {c.shape[0] // 2} for {kind} "

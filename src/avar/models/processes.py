@@ -136,7 +136,7 @@ class NoiseModel:
         """Simulate ``replicates`` independent series of length ``n`` at once.
 
         Returns a C-contiguous float64 array of shape (replicates, n), one
-        series per row (pass ``.T`` to :func:`avar.stability.columns.allan_variance_columns`).
+        series per row (pass ``.T`` to :func:`avar.stability.allan.columns.allan_variance_columns`).
         Row 0 of a single replicate equals :meth:`simulate` with the same seed.
 
         Examples

@@ -26,62 +26,9 @@ from typing import Any
 
 import numpy as np
 
+from avar.models.arguments import as_float_array, as_nonnegative, as_phi, as_whole
+
 __all__ = ["av_wn", "av_qn", "av_rw", "av_dr", "av_ar1"]
-
-
-# --------------------------------------------------------------------------- validation
-def _as_float_array(x: Any, name: str) -> np.ndarray:
-    """Convert ``x`` to a finite float64 array or raise TypeError/ValueError."""
-    if x is None or isinstance(x, (str, bytes)):
-        raise TypeError(f"{name} must be a real number or an array of real numbers, "
-                        f"got {type(x).__name__}")
-    try:
-        arr = np.asarray(x)
-    except Exception as exc:  # pragma: no cover - exotic objects
-        raise TypeError(f"{name} must be a real number or an array of real numbers, "
-                        f"got {type(x).__name__}") from exc
-    if arr.dtype.kind not in "iuf":
-        raise TypeError(f"{name} must be a real number or an array of real numbers "
-                        f"(int or float), got dtype {arr.dtype}")
-    arr = arr.astype(np.float64)
-    if arr.size == 0:
-        raise ValueError(f"{name} must not be empty")
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        raise ValueError(f"{name} must be finite (no NaN or inf), got {float(arr[bad].flat[0]):g}")
-    return arr
-
-
-def _as_whole(x: Any, name: str, minimum: int = 1) -> np.ndarray:
-    """Validate whole numbers >= ``minimum`` (1.0 accepted, 1.5 rejected); int64 array."""
-    arr = _as_float_array(x, name)
-    frac = arr != np.floor(arr)
-    if frac.any():
-        raise ValueError(f"{name} must be whole numbers (integers such as 1, 2, 8.0), "
-                         f"got {float(arr[frac].flat[0])!r}")
-    low = arr < minimum
-    if low.any():
-        raise ValueError(f"{name} must be >= {minimum}, got {arr[low].flat[0]:g}")
-    if (arr > 2.0**62).any():
-        raise ValueError(f"{name} is too large (must be < 2**62)")
-    return arr.astype(np.int64)
-
-
-def _as_nonnegative(x: Any, name: str) -> np.ndarray:
-    arr = _as_float_array(x, name)
-    neg = arr < 0
-    if neg.any():
-        raise ValueError(f"{name} must be >= 0 (a variance), got {arr[neg].flat[0]:g}")
-    return arr
-
-
-def _as_phi(x: Any, name: str = "phi") -> np.ndarray:
-    arr = _as_float_array(x, name)
-    bad = np.abs(arr) >= 1
-    if bad.any():
-        raise ValueError(f"{name} must satisfy |{name}| < 1 (stationary AR(1)), "
-                         f"got {arr[bad].flat[0]:g}")
-    return arr
 
 
 def _finish(result: np.ndarray, *inputs: np.ndarray) -> float | np.ndarray:
@@ -101,8 +48,8 @@ def _broadcast(*arrays: np.ndarray, names: tuple[str, ...]) -> None:
 
 def _parameter_and_factors(value: Any, name: str, n: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A non-negative parameter and the averaging factors (int and float), broadcastable."""
-    parameter = _as_nonnegative(value, name)
-    m = _as_whole(n, "n")
+    parameter = as_nonnegative(value, name)
+    m = as_whole(n, "n")
     _broadcast(parameter, m, names=(name, "n"))
     return parameter, m, m.astype(np.float64)
 
@@ -241,8 +188,8 @@ def av_dr(delta: Any, n: Any) -> float | np.ndarray:
     >>> av_dr(0.5, [1, 2])
     array([0.125, 0.5  ])
     """
-    d = _as_float_array(delta, "delta")
-    m = _as_whole(n, "n")
+    d = as_float_array(delta, "delta")
+    m = as_whole(n, "n")
     _broadcast(d, m, names=("delta", "n"))
     mf = m.astype(np.float64)
     drift = mf * d  # n delta, then one rounding into the result: no double rounding among subnormals
@@ -293,9 +240,9 @@ def av_ar1(n: Any, phi: Any, sigma2: Any) -> float | np.ndarray:
     >>> av_ar1([1, 2], 0.0, 2.0)   # phi = 0 is white noise: sigma2 / n
     array([2., 1.])
     """
-    m = _as_whole(n, "n")
-    p = _as_phi(phi)
-    s2 = _as_nonnegative(sigma2, "sigma2")
+    m = as_whole(n, "n")
+    p = as_phi(phi)
+    s2 = as_nonnegative(sigma2, "sigma2")
     _broadcast(m, p, s2, names=("n", "phi", "sigma2"))
     mf, pb, s2b = np.broadcast_arrays(m.astype(np.float64), p, s2)
     num = np.empty(mf.shape)

@@ -10,8 +10,8 @@ from matplotlib.axes import Axes
 from matplotlib.colors import is_color_like
 from matplotlib.figure import Figure, FigureBase
 
-from avar.stability.chi2 import format_confidence
-from avar.stability.results import AllanVariance
+from avar.stability.allan.results import AllanVariance
+from avar.stability.uncertainty.chi2 import format_confidence
 
 #: Colour of the empirical curve (R ``avar``: "darkblue").
 AD_COLOUR = "darkblue"

@@ -20,7 +20,7 @@ from avar.plotting.base import (
     new_axes,
     setup_log_axes,
 )
-from avar.stability.results import AllanVariance
+from avar.stability.allan.results import AllanVariance
 
 
 def compare_items(results: Any, labels: Any) -> list[tuple[str, AllanVariance]]:

@@ -29,7 +29,7 @@ from avar.plotting.base import (
     root_figure,
     setup_log_axes,
 )
-from avar.stability.results import ImuAllanVariance
+from avar.stability.allan.results import ImuAllanVariance
 
 __all__ = ["plot_imu_avar", "plot_imu_avlr"]
 

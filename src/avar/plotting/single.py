@@ -57,7 +57,7 @@ from avar.plotting.base import (
     setup_log_axes,
     values_of,
 )
-from avar.stability.results import AllanVariance
+from avar.stability.allan.results import AllanVariance
 
 
 def plot_avar(

@@ -18,13 +18,13 @@ import numpy as np
 
 from avar._kernels.stream import stream_update
 from avar._validation import check_freq, short_repr
-from avar.stability.chi2 import CATALOGUE_QUANTILES
-from avar.stability.deviation_grids import term_counts
-from avar.stability.deviation_inputs import DATA_TYPES, DEFAULT_CONFIDENCE, check_data
-from avar.stability.deviation_results import Deviation
-from avar.stability.edf import chi2_bounds, estimator_edf
-from avar.stability.grids import grid_factors
-from avar.stability.noise_types import check_alpha
+from avar.stability.shared.deviation import Deviation
+from avar.stability.shared.deviation_grids import term_counts
+from avar.stability.shared.grids import grid_factors
+from avar.stability.shared.inputs import DATA_TYPES, DEFAULT_CONFIDENCE, check_data
+from avar.stability.shared.noise_types import check_alpha
+from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES
+from avar.stability.uncertainty.edf import chi2_bounds, estimator_edf
 
 #: Statistic -> (kernel kind, points spanned per m, divisor K of the variance).
 STREAM_STATISTICS = {"oadev": (0, 2, 2.0), "adev": (1, 2, 2.0), "ohdev": (2, 3, 6.0), "hdev": (3, 3, 6.0),

@@ -19,8 +19,8 @@ from avar.fit.gmwm.objective import WEIGHTINGS, equivalent_dof, fit_av
 from avar.fit.gmwm.results import GmwmResult, ImuGmwmResult
 from avar.imu import ACCELEROMETER, GYROSCOPE, IMU
 from avar.recording import Recording
-from avar.stability.allan import avar as allan_variance
-from avar.stability.results import AllanVariance, ImuAllanVariance
+from avar.stability.allan.estimator import avar as allan_variance
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 
 __all__ = ["gmwm", "octave_factors", "empirical_allan_variance", "fit_allan_variance"]
 

@@ -12,7 +12,7 @@ import pandas as pd
 from avar._frozen import frozen_array, frozen_frame, frozen_mapping, frozen_series
 from avar.fit.gmwm.model import continuous_parameters
 from avar.models import NoiseModel
-from avar.stability.results import AllanVariance, ImuAllanVariance
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 
 __all__ = ["GmwmResult", "ImuGmwmResult"]
 

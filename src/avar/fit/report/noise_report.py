@@ -27,8 +27,8 @@ from avar.fit.report.rows import channel_rows, minimum_row
 from avar.fit.report.sensor_fit import SensorFit, fit_sensor_model
 from avar.fit.report.uncertainty import non_overlapping_fit, with_level_covariance
 from avar.imu import IMU
-from avar.stability.allan import avar as allan_variance
-from avar.stability.results import AllanVariance, ImuAllanVariance
+from avar.stability.allan.estimator import avar as allan_variance
+from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 
 __all__ = ["noise_report", "infer_sensor_type", "fit_channel"]
 
@@ -81,7 +81,7 @@ def _estimator(robust: bool, type: str) -> Any:
         return lambda values, freq, taus: allan_variance(values, type=type, freq=freq, taus=taus)
     if type != "mo":
         raise ValueError(f"robust=True estimates the maximal-overlap Allan variance; type must be 'mo', got {type!r}")
-    from avar.stability.robust import robust_allan_variance
+    from avar.stability.robust.estimator import robust_allan_variance
 
     return lambda values, freq, taus: robust_allan_variance(values, freq=1.0 if freq is None else freq, taus=taus)
 
@@ -163,7 +163,7 @@ def _band(av: AllanVariance, implied: np.ndarray, alpha: float) -> tuple[np.ndar
     """Lower and upper 1 - alpha chi-squared bounds of the deviation and Greenhall's EDF, at the model's noise
     types (power-law alpha: AV slope mu gives -1 - mu, and 2 (white PM) below -1.5), for the estimator's
     overlap."""
-    from avar.stability.edf import chi2_bounds, greenhall_edf
+    from avar.stability.uncertainty.edf import chi2_bounds, greenhall_edf
 
     factors = np.asarray(av.averaging_factors, dtype=np.int64)
     slope = np.gradient(np.log(implied), np.log(factors)) if factors.size > 1 else np.zeros(1)
@@ -242,7 +242,7 @@ def noise_report(
     from_bag : bool
         The data came from a ROS bag (SI units by definition): a non-SI unit is warned about.
     robust : bool
-        Estimate the Allan variance robustly (:func:`avar.stability.robust.robust_allan_variance`):
+        Estimate the Allan variance robustly (:func:`avar.stability.robust.estimator.robust_allan_variance`):
         a log with a few per cent of spikes gives the terms of the clean process.
 
     Returns

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from avar._frozen import frozen_mapping
-from avar.stability.results import format_frequency
+from avar.stability.allan.results import format_frequency
 
 __all__ = ["NoiseReport"]
 

@@ -1,0 +1,234 @@
+"""The computational core of the deviation family: variances and term counts per level.
+
+:func:`deviation_levels` turns clean float64 data (NaN marks a gap) into the
+variance and the number of terms of every level, through the kernels of
+:mod:`avar._kernels.classic.levels` (ADEV and HDEV of gap-free frequency data at
+the octave factors m = 1, 2, 4, ...: the Haar pyramid of
+:mod:`avar._kernels.classic.pyramid`, one read of the data).
+:func:`deviation_levels_and_phase` also hands back what the noise
+identification needs without another pass over the data: the detrended phase
+it built, or, from the pyramid, an :class:`OctaveMoments`. It validates
+nothing: the public functions of :mod:`avar.stability.classic.deviations` do, once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import NamedTuple
+
+import numpy as np
+
+from avar._kernels.classic.levels import detrended_phase, level_sums, scan
+from avar._kernels.classic.phase import centred_moment
+from avar._kernels.classic.pyramid import MOMENTS, SUM_COLUMN, TAIL, octave_moments
+from avar._kernels.uncertainty.noise_id import rn_clusters
+from avar.stability.shared.deviation_grids import KERNEL_CODES, term_counts, term_ranges
+
+#: Denominator constant of every estimator: sigma^2 = sum / (K m^2 tau0^2 n) (MDEV: K m^4 tau0^2 n).
+_K = {"adev": 2.0, "oadev": 2.0, "mdev": 2.0, "tdev": 2.0, "hdev": 6.0, "ohdev": 6.0, "totdev": 2.0}
+
+
+_NO_LO = np.zeros(1, dtype=np.float32)
+
+
+def _filled(data: np.ndarray, is_phase: bool, n_missing: int) -> tuple[np.ndarray, np.ndarray | None]:
+    """Data with NaN filled (any finite value keeps the terms exact) and the prefix count of gaps."""
+    if n_missing == 0:
+        return data, None
+    missing = np.isnan(data)
+    bad = np.concatenate(([0], np.cumsum(missing, dtype=np.int64)))
+    good = np.flatnonzero(~missing)
+    filled = data.copy()
+    if is_phase:  # linear interpolation keeps the increments small
+        filled[missing] = np.interp(np.flatnonzero(missing), good, data[good])
+    else:
+        filled[missing] = data[good].mean()
+    return filled, bad
+
+
+def _drift(data: np.ndarray, is_phase: bool, moment: float = np.nan) -> float:
+    """Least-squares slope of the increments (the frequency, or the phase's differences)
+    against their index, rounded so that ``slope * i`` is exact for every index (the
+    Hadamard family removes it). ``moment``: their centred moment if already known (NaN
+    if not: :func:`scan` finds it for gap-free frequency data)."""
+    count = data.shape[0] - int(is_phase)
+    if count < 3:
+        return 0.0
+    if np.isnan(moment):
+        moment = centred_moment(data, int(is_phase))
+    slope = moment / (count * (count * count - 1.0) / 12.0)
+    if slope == 0.0 or not np.isfinite(slope):
+        return 0.0
+    _, exponent = np.frexp(slope)
+    bits = 52 - int(count).bit_length()
+    return float(np.ldexp(np.round(np.ldexp(slope, bits - int(exponent))), int(exponent) - bits))
+
+
+def _scale(low: float, high: float, origin: float) -> float:
+    """A power of two that brings the data's span about ``origin`` near 1 (no overflow, exact)."""
+    with np.errstate(over="ignore"):
+        span = max(high - origin, origin - low)
+    _, exponent = np.frexp(span if np.isfinite(span) and span > 0 else 1.0)
+    return float(np.ldexp(1.0, -int(np.clip(exponent, -1000, 1000))))
+
+
+class OctaveMoments(NamedTuple):
+    """What the noise identification of the pyramid's levels needs (see :mod:`avar._kernels.classic.pyramid`).
+
+    ``stats``: the moments of every level (columns ``MOMENTS``); ``tails``:
+    the cluster sums of the levels with at most ``TAIL`` clusters;
+    ``phase()``: builds the detrended phase (one O(N) pass), for the rare
+    level the moments cannot decide; ``clusters(step)``: the phase at every
+    ``step``-th point and its running sum there, for R(n).
+    """
+
+    stats: np.ndarray
+    tails: np.ndarray
+    phase: Callable[[], np.ndarray]
+    clusters: Callable[[int], tuple[np.ndarray, np.ndarray]]
+
+
+def _octave_sums(estimator: str, data: np.ndarray, factors: np.ndarray, scanned: tuple):
+    """ADEV/HDEV of gap-free frequency data at m = 1, 2, 4, ... by the Haar pyramid
+    (:mod:`avar._kernels.classic.pyramid`): ``sums, counts, scale, moments, drift``."""
+    _, total, low, high, moment = scanned
+    count = data.shape[0]
+    slope = _drift(data, False, moment) if estimator == "hdev" else 0.0
+    centre = total / count - slope * (count - 1) / 2
+    scale = _scale(low, high, centre)
+    stats = np.zeros((factors.size, len(MOMENTS)))
+    tails = np.zeros((factors.size, TAIL))
+    order = 1 if estimator == "adev" else 2
+    octave_moments(data, float(centre), slope, scale, order, factors.size, stats, tails)
+    sums = np.ascontiguousarray(stats[:, SUM_COLUMN[order]])
+
+    def phase() -> np.ndarray:
+        return phase_parts(data, "freq", estimator, scanned)[5]
+
+    def clusters(step: int) -> tuple[np.ndarray, np.ndarray]:
+        z = np.empty(count // step + 1)
+        running = np.empty((count + 1) // step + 1)
+        rn_clusters(data, float(centre), slope, scale, step, z, running)
+        return z, running
+
+    moments = OctaveMoments(stats, tails, phase, clusters)
+    return sums, term_counts(estimator, count + 1, factors), scale, moments, slope * scale
+
+
+def _is_octave(factors: np.ndarray) -> bool:
+    return bool(factors.size) and bool(np.array_equal(factors, 2 ** np.arange(factors.size, dtype=np.int64)))
+
+
+def detrended_phase_of(data: np.ndarray, data_type: str, estimator: str):
+    """The compensated, detrended, scaled phase of ``data`` and what the kernels need (see :func:`phase_parts`)."""
+    return phase_parts(data, data_type, estimator)[:5]
+
+
+def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple | None = None):
+    """The compensated, detrended, scaled phase of ``data`` and what the kernels need.
+
+    Returns ``hi, lo, scale, mode, bad``: the phase ``(hi + lo) / scale`` (in
+    the data's units for phase data, in frequency units times samples for
+    frequency data) with its mean frequency (and, for HDEV and OHDEV, its
+    linear frequency drift) removed, the gap mode and the prefix count of
+    gaps (see :mod:`avar._kernels.classic.levels`); then ``phase``, the
+    detrended phase ``hi`` itself (for MDEV, before its running sum),
+    ``drift``: ``phase`` lacks ``drift * k (k - 1) / 2`` (the Hadamard family's
+    removed linear frequency drift), and ``line``: for phase data, ``phase``
+    lacks ``line * k`` too (their frequency offset, which Stable32's noise
+    identification sees); None for frequency data. ``scanned``: :func:`scan`
+    of ``data`` if already known.
+    """
+    is_phase = data_type == "phase"
+    n_missing, total, low, high, moment = scan(data) if scanned is None else scanned
+    filled, bad = _filled(data, is_phase, n_missing)
+    count = filled.shape[0] - 1 if is_phase else filled.shape[0]
+    slope = 0.0
+    if estimator in ("hdev", "ohdev"):
+        slope = _drift(filled, is_phase, np.nan if is_phase else moment)
+    if is_phase:
+        centre = (filled[-1] - filled[0]) / count - slope * (count - 1) / 2
+        origin = filled[0]
+    else:
+        centre = total / (count - n_missing) - slope * (count - 1) / 2
+        origin = centre
+    scale = _scale(low, high, origin)
+    hi = np.empty(count + 1)
+    lo = np.empty(count + 1, dtype=np.float32)
+    detrended_phase(filled, _NO_LO, int(is_phase), float(centre), slope, scale, hi, lo)
+    phase = hi
+    if estimator in ("mdev", "tdev"):  # MDEV's terms are third differences of the running sum
+        running_hi = np.empty(count + 2)
+        running_lo = np.empty(count + 2, dtype=np.float32)
+        detrended_phase(hi, lo, 2, float(np.mean(hi)), 0.0, 1.0, running_hi, running_lo)
+        hi, lo = running_hi, running_lo
+    mode = 0 if bad is None else (1 if is_phase else 2)
+    return hi, lo, scale, mode, bad, phase, slope * scale, (centre * scale if is_phase else None)
+
+
+def deviation_levels(
+    estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str = "phase", rate: float = 1.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Variance and number of terms of one estimator at every averaging factor.
+
+    Parameters
+    ----------
+    estimator : {"adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev"}
+    data : float64 ndarray
+        Phase (s) or fractional frequency; NaN marks a gap, and the terms
+        that touch one are skipped (see :mod:`avar._kernels.classic.levels`).
+    factors : int64 ndarray
+        Averaging factors m, each within the estimator's range.
+    data_type : {"phase", "freq"}
+    rate : float
+        Sampling rate (Hz).
+
+    Returns
+    -------
+    variance : float64 ndarray
+        The estimator's variance (TDEV: s^2; the others dimensionless), NaN
+        where no term is left.
+    n : int64 ndarray
+        Terms averaged at every level.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> y = np.array([0.0, 1.0, 0.0, 1.0, 0.0])
+    >>> variance, n = deviation_levels("oadev", y, np.array([1, 2]), data_type="freq")
+    >>> variance.tolist(), n.tolist()
+    ([0.5, 0.0], [4, 2])
+    """
+    return deviation_levels_and_phase(estimator, data, factors, data_type, rate)[:2]
+
+
+def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str = "phase",
+                               rate: float = 1.0, scanned: tuple | None = None):
+    """:func:`deviation_levels` and what the noise identification needs.
+
+    Returns ``variance, n, phase, drift, line``: ``phase`` the detrended phase it
+    used (scaled by a power of two, as in :func:`phase_parts`) or, on the
+    pyramid's path (frequency data), an :class:`OctaveMoments`; ``drift`` and
+    ``line`` as in :func:`phase_parts`.
+    """
+    factors = np.asarray(factors, dtype=np.int64)
+    n_phase = data.shape[0] + (data_type == "freq")
+    scanned = scan(data) if scanned is None else scanned
+    if estimator in ("adev", "hdev") and data_type == "freq" and scanned[0] == 0 and _is_octave(factors):
+        sums, counts, scale, phase, drift = _octave_sums(estimator, data, factors, scanned)
+        line = None
+    else:
+        hi, lo, scale, mode, bad, phase, drift, line = phase_parts(data, data_type, estimator, scanned)
+        strides, first, last = term_ranges(estimator, n_phase, factors)
+        sums, counts = level_sums(hi, lo, KERNEL_CODES[estimator], factors, strides, first, last, mode, bad)
+    m = factors.astype(np.float64)
+    denominator = _K[estimator] * m * m * (m * m if estimator in ("mdev", "tdev") else 1.0)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        variance = sums / (denominator * counts) / scale / scale
+        if data_type == "phase":
+            variance = variance * rate * rate
+        if estimator == "tdev":
+            tau = m / rate
+            variance = variance * tau * tau / 3.0
+    variance[counts == 0] = np.nan
+    return variance, counts, phase, drift, line

@@ -1,0 +1,123 @@
+"""TheoBR's bias factor kf: the mean ratio of the overlapping Allan variance to Theo1 over a range of taus.
+
+Howe and Tasset 2004, Taylor and Howe 2010; the range as Stable32 (:func:`theobr_count`). ThêoH
+scales its Theo1 levels by kf, and Stable32 scales Theo1 by it when the noise is fixed to other
+than white FM.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avar._kernels.total.fft import autocorrelation
+from avar._kernels.total.theo1 import split_sums
+from avar._kernels.total.theobr import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
+from avar._kernels.total.windows import theo1_sum
+
+#: Fewest phase points: the average needs n = floor(N / 6) - 3 >= 0 and Allan terms at m = 9 + 3n.
+MIN_THEOBR_POINTS = 19
+#: Relative error of an expanded Theo1 sum per unit of its conditioning ratio (measured:
+#: at most 6.7e-15 over the levels of random-walk FM, N = 2e4, against the direct sums).
+ERROR_PER_RATIO = 1e-14
+#: Relative error allowed in TheoBR's kf from the expanded Theo1 sums of its average (kf is
+#: an estimate whose own statistical uncertainty is of order 1e-2; ThêoH prints 5 digits).
+KF_TOLERANCE = 1e-8
+#: The split groups of kf's ill-conditioned Theo1 sums reach down to 1 / KF_REACH of their knot
+#: spacing (ratio up to about 1e4 on random-walk FM: 1e-10, far below kf's tolerance).
+KF_REACH = 16
+#: The same for kf's ill-conditioned overlapping Allan sums (with N / 30 of them, reaching 1 / 16
+#: left about 200 of random-walk FM's 33,331 at N = 1e6 to be summed directly; 1 / 8 none, for the
+#: same cost of splits).
+KF_ALLAN_REACH = 8
+
+
+def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[float, int]:
+    """TheoBR's bias factor kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(9 + 3i) / Theo1(12 + 4i),
+    n = floor(N / 6) - 3 (both at tau = (9 + 3i) tau0; AVAR overlapping), and n (:func:`theobr_count`).
+
+    ``x``: gap-free phase, N >= 19 points; ``autocorr``: its FFT autocorrelation, if at hand.
+    The units cancel in the ratio.
+    """
+    terms, n = theobr_terms(x, autocorr)
+    return float(np.mean(terms)), n
+
+
+def theobr_count(n_points: int) -> int:
+    """The last index n of TheoBR's average: floor(N / 6) - 3, as Stable32 computes ThêoH and Theo1's
+    bias removal (the Allan factors 9 + 3i then reach N / 2). Where N is a multiple of 6 the last
+    factor would leave no Allan term, and the average stops one short.
+
+    Howe, Taylor and Tasset's fast TheoBR averages to n = floor(0.1 N / 3) - 3 instead; on
+    Stable32's tables of two records only floor(N / 6) - 3 reproduces the printed values (to
+    their 5 digits: kf = 0.602787 at N = 1001, 1.349115 at N = 1253; the other count gives
+    1.0857 and 1.3171).
+
+    >>> theobr_count(1001), theobr_count(1253), theobr_count(1002)
+    (163, 205, 163)
+    """
+    n = int(n_points) // 6 - 3
+    return n - 1 if int(n_points) % 6 == 0 else n
+
+
+def theobr_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+    """The n + 1 terms AVAR(9 + 3i) / Theo1(12 + 4i) of :func:`theobr_factor`'s mean, and n.
+
+    OAVAR and Theo1 sums by FFT (:func:`avar._kernels.total.theobr.oavar_expanded`, :func:`theo1_every`);
+    the ill-conditioned ones by the split expansion (:func:`avar._kernels.total.theo1.split_sums`),
+    each kind as far as half of kf's tolerance needs (see :func:`_levels_to_redo`), and directly
+    if that is not enough either."""
+    n_points = x.shape[0]
+    n = theobr_count(n_points)
+    i = np.arange(n + 1, dtype=np.int64)
+    m_avar = 9 + 3 * i
+    m_theo = 12 + 4 * i
+    autocorr = autocorrelation(x) if autocorr is None else autocorr
+    diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), int(m_avar[-1]) + 1)
+    avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
+    avar_norm = 2.0 * m_avar * m_avar * (n_points - 2 * m_avar)
+    every, ratio = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
+    theo_norm = 0.75 * (n_points - m_theo) * m_theo * m_theo
+    sums, ratio = every[m_theo], ratio[m_theo]
+    # each of the two kinds of sums may bring half of kf's tolerance
+    redo = _levels_to_redo(avar_sums / avar_norm * theo_norm / sums, avar_ratio, 0.5)
+    if redo.size:  # by the split expansion, then directly
+        _take_better(avar_sums, avar_ratio, redo, *split_sums(x, np.zeros(0), KF_ALLAN_REACH, m_avar[redo])[2:])
+        redo = redo[np.isin(redo, _levels_to_redo(avar_sums / avar_norm * theo_norm / sums, avar_ratio, 0.5))]
+        avar_sums[redo] = oavar_sums(x, m_avar[redo])
+    avar = avar_sums / avar_norm
+    split = _levels_to_redo(avar * theo_norm / sums, ratio, 0.5)  # first by the split expansion
+    if split.size:
+        _take_better(sums, ratio, split, *split_sums(x, m_theo[split], KF_REACH)[:2])
+    theo = sums / theo_norm
+    no_gaps = np.zeros(0, dtype=np.int64)
+    for level in _levels_to_redo(avar / theo, ratio, 0.5):
+        theo[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0] / theo_norm[level]
+    return avar / theo, n
+
+
+def _take_better(sums: np.ndarray, ratio: np.ndarray, levels: np.ndarray, new: np.ndarray,
+                 new_ratio: np.ndarray) -> None:
+    """Replace ``sums`` and ``ratio`` at ``levels`` by ``new`` where its ratio is lower."""
+    better = new_ratio < ratio[levels]
+    sums[levels[better]] = new[better]
+    ratio[levels[better]] = new_ratio[better]
+
+
+def _levels_to_redo(terms: np.ndarray, ratio: np.ndarray, share: float = 1.0) -> np.ndarray:
+    """The levels of kf's average to sum again: the worst-conditioned first, until the error
+    the others can bring to the mean of ``terms`` is below ``share`` x :data:`KF_TOLERANCE`.
+
+    A level's expanded sum errs by about ERROR_PER_RATIO x its ratio (relative), which
+    reaches its term of the mean; kf averages thousands of levels, so it needs far fewer
+    direct sums than a per-level tolerance would (random-walk FM, N = 1e5: about 50 of 3332
+    levels, the smallest m, instead of 1368). A non-finite term or ratio is always redone.
+    """
+    error = np.abs(terms) * ERROR_PER_RATIO * ratio
+    error[~np.isfinite(error)] = np.inf
+    order = np.argsort(-error, kind="stable")
+    remaining = np.cumsum(error[order][::-1])[::-1]  # error of the levels from this one on
+    finite = np.abs(terms[np.isfinite(terms)])
+    # the mean's scale from the median term, which a few ill-conditioned terms cannot inflate
+    budget = share * KF_TOLERANCE * terms.size * (float(np.median(finite)) if finite.size else 0.0)
+    count = int(np.count_nonzero(~(remaining <= budget)))
+    return np.sort(order[:count])

@@ -1,0 +1,109 @@
+"""The compiled lag-1 noise identification against its plain NumPy twin."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avar._kernels.uncertainty.noise_id import lag1_alpha_decimated, moments_with_drift
+from avar.stability.uncertainty.noise_id import lag1_alpha
+
+
+def plain_alpha(x: np.ndarray, m: int, dmax: int) -> float:
+    """Decimate, remove the least-squares line (numpy.polynomial), then the NumPy lag-1 rule."""
+    z = x[::m]
+    u = np.linspace(-1.0, 1.0, z.size)
+    trend = np.polynomial.polynomial.polyval(u, np.polynomial.polynomial.polyfit(u, z, 1))
+    return lag1_alpha(z - trend, dmax)
+
+
+def series(kind: str, n: int, seed: int) -> np.ndarray:
+    w = np.random.default_rng(seed).standard_normal(n)
+    drift = 1e3 + 0.5 * np.arange(n)  # a phase and a frequency offset: removed by both
+    return {"white pm": w, "white fm": np.cumsum(w), "rw fm": np.cumsum(np.cumsum(w))}[kind] + drift
+
+
+@pytest.mark.parametrize("kind", ["white pm", "white fm", "rw fm"])
+@pytest.mark.parametrize("dmax", [2, 3])
+def test_kernel_equals_the_numpy_twin(kind, dmax):
+    hits = 0
+    for seed in range(6):
+        x = series(kind, 5000, seed)
+        for m in (1, 2, 3, 7, 16, 64, 150):
+            got, expected = lag1_alpha_decimated(x, m, dmax, np.nan), plain_alpha(x, m, dmax)
+            assert got == expected, (kind, seed, m)
+            hits += 1
+    assert hits == 42
+
+
+@pytest.mark.parametrize("kind", ["white pm", "white fm", "rw fm"])
+@pytest.mark.parametrize("dmax", [2, 3])
+def test_phase_data_keep_their_line(kind, dmax):
+    # phase data: the kernel gets the line the caller removed back and takes only the mean off,
+    # as the twin does with the decimated phase as given (no least-squares line)
+    for seed in range(6):
+        w = np.random.default_rng(seed).standard_normal(1200)
+        given = {"white pm": w, "white fm": np.cumsum(w), "rw fm": np.cumsum(np.cumsum(w))}[kind]
+        given = given + 0.02 * np.arange(1200) * given.std() / 1200  # a small frequency offset
+        slope = (given[-1] - given[0]) / 1199
+        detrended = given - slope * np.arange(1200)
+        for m in (1, 2, 5, 16, 40):
+            assert lag1_alpha_decimated(detrended, m, dmax, slope) == lag1_alpha(given[::m], dmax), (kind, seed, m)
+
+
+def test_a_large_frequency_offset_of_phase_data_keeps_its_digits():
+    # 1e12 times the noise: the offset sends order 0 to the differences, which the kernel forms
+    # from the least-squares residuals; white PM and white FM are still told apart
+    for seed in range(4):
+        w = np.random.default_rng(seed).standard_normal(3000)
+        for noise, alpha in ((w, 2.0), (np.cumsum(w), 0.0)):
+            assert lag1_alpha_decimated(noise, 1, 2, 1e12) == alpha
+            assert lag1_alpha_decimated(noise, 1, 2, 0.0) == alpha  # no offset: order 0 decides the same
+
+
+def test_constant_series_gives_nan():
+    assert np.isnan(lag1_alpha_decimated(np.full(100, 3.5), 1, 2, np.nan))
+    assert np.isnan(lag1_alpha_decimated(np.full(100, 3.5), 1, 2, 0.0))
+
+
+@pytest.mark.parametrize("factors", [[1, 2, 4, 8, 16, 32, 64, 128], [1, 3, 6, 7, 14, 100, 200], [5], [2, 4]])
+def test_levels_serial_split_and_single_agree(factors):
+    from avar._kernels.uncertainty.noise_id import lag1_levels, lag1_levels_split
+
+    x = series("white fm", 20_000, 1)
+    m = np.array(factors, dtype=np.int64)
+    for line in (np.nan, 0.0, -0.5):  # frequency data; phase data as given and less a line
+        serial, split = np.empty(m.size), np.empty(m.size)
+        lag1_levels(x, m, 2, line, serial)
+        lag1_levels_split(x, m, 2, line, split)
+        single = [lag1_alpha_decimated(x, int(f), 2, line) for f in m]
+        np.testing.assert_array_equal(serial, single)
+        np.testing.assert_array_equal(split, single)
+
+
+@pytest.mark.parametrize("kind", ["white pm", "white fm"])
+def test_a_frequency_drift_stays_for_the_differences(kind):
+    # only the line is removed (Stable32): a drift's parabola reaches the differencing, which
+    # the twin reproduces, and second differences still read white PM / white FM
+    for seed in range(4):
+        x = series(kind, 3000, seed) + 1e-3 * np.arange(3000.0) ** 2
+        got = lag1_alpha_decimated(x, 1, 2, np.nan)
+        assert got == plain_alpha(x, 1, 2) == (2.0 if kind == "white pm" else 0.0)
+
+
+def plain_moments(z: np.ndarray) -> np.ndarray:
+    """The 16 moments of :data:`avar._kernels.classic.pyramid.MOMENTS` of points z_0 .. z_C, by NumPy."""
+    c = z.size - 1
+    t = np.arange(c + 1) - c / 2.0
+    d1, d2, d3, d4 = (np.diff(z, k) for k in (1, 2, 3, 4))
+    return np.array([c, z.sum(), (t * z).sum(), (t * t * z).sum(), (z * z).sum(), (d1 * d1).sum(), (d2 * d2).sum(),
+                     (d3 * d3).sum(), (d4 * d4).sum(), z[-1], d1[0], d1[-1], d2[0], d2[-1], d3[0], d3[-1]])
+
+
+@pytest.mark.parametrize("count, m, drift", [(5, 1, 0.3), (40, 7, 3e-3), (333, 64, -2e-7)])
+def test_moments_with_drift_equal_the_moments_of_the_drifted_points(count, m, drift):
+    z = np.concatenate(([0.0], np.cumsum(np.random.default_rng(count).standard_normal(count))))
+    i = np.arange(count + 1.0) * m
+    want = plain_moments(z + drift * i * (i - 1.0) / 2.0)
+    got = moments_with_drift(plain_moments(z), drift, m)
+    np.testing.assert_allclose(got, want, rtol=1e-11, atol=1e-11 * np.abs(want).max())
