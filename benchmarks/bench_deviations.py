@@ -53,7 +53,8 @@ from timing import median_time  # benchmarks/timing.py
 
 import avar
 from avar.stability.classic.core import deviation_levels
-from avar.stability.shared.deviation_grids import ESTIMATORS, deviation_factors
+from avar.stability.shared.grids import deviation_factors
+from avar.stability.shared.registry import CLASSIC as ESTIMATORS
 
 try:
     import allantools

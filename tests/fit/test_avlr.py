@@ -24,7 +24,8 @@ from avar.models import DR, QN, RW, WN
 from avar.stability.allan.estimator import avar
 from avar.stability.allan.intervals import relative_errors
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
-from avar.stability.shared.grids import averaging_factors, n_differences
+from avar.stability.shared.grids import averaging_factors
+from avar.stability.shared.term_counts import n_differences
 
 # The package re-exports the function avlr under the name of its submodule.
 bootstrap_module = importlib.import_module("avar.fit.bootstrap")

@@ -20,7 +20,7 @@ import pytest
 
 from avar.io import datasets
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
-from avar.stability.shared.grids import n_differences
+from avar.stability.shared.term_counts import n_differences
 
 GYRO, ACCEL = "Gyroscope", "Accelerometer"
 REPOSITORY = Path(__file__).resolve().parents[2]

@@ -15,8 +15,8 @@ import pandas as pd
 
 from avar.cli.common import Progress, UsageError
 from avar.cli.outputs import plan_outputs, report
+from avar.stability.shared.confidence import DEFAULT_CONFIDENCE
 from avar.stability.shared.registry import DEVIATION_STATISTICS
-from avar.stability.uncertainty.chi2 import DEFAULT_CONFIDENCE
 
 #: Columns of the printed table, as Stable32's run table.
 TABLE_COLUMNS = ["AF", "Tau", "#", "Alpha", "Min Sigma", "Sigma", "Max Sigma"]

@@ -31,7 +31,8 @@ import numpy as np
 import pandas as pd
 
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
-from avar.stability.shared.grids import check_type, n_differences
+from avar.stability.shared.grids import check_type
+from avar.stability.shared.term_counts import n_differences
 
 #: Directory of the ``<name>.npz`` files, inside the package ``avar.io``.
 DATA_DIRECTORY = "data"

@@ -11,7 +11,7 @@ from matplotlib.colors import is_color_like
 from matplotlib.figure import Figure, FigureBase
 
 from avar.stability.allan.results import AllanVariance
-from avar.stability.uncertainty.chi2 import format_confidence
+from avar.stability.shared.confidence import format_confidence
 
 #: Colour of the empirical curve (R ``avar``: "darkblue").
 AD_COLOUR = "darkblue"

@@ -22,8 +22,8 @@ from avar.plotting.base import (
     new_axes,
     setup_log_axes,
 )
+from avar.stability.shared.confidence import format_confidence
 from avar.stability.shared.deviation import Deviation
-from avar.stability.uncertainty.chi2 import format_confidence
 
 
 def plot_deviation(

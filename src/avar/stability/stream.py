@@ -19,10 +19,10 @@ import numpy as np
 from avar._kernels.stream import stream_update
 from avar._validation import check_freq, short_repr
 from avar.stability.shared.deviation import Deviation
-from avar.stability.shared.deviation_grids import term_counts
 from avar.stability.shared.grids import grid_factors
 from avar.stability.shared.inputs import DATA_TYPES, DEFAULT_CONFIDENCE, check_data
 from avar.stability.shared.noise_types import check_alpha
+from avar.stability.shared.term_counts import term_counts
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES
 from avar.stability.uncertainty.edf import chi2_bounds, estimator_edf
 

@@ -9,8 +9,11 @@ import numpy as np
 import pytest
 
 from avar._kernels.classic.levels import detrended_phase, level_sums, scan
-from avar.stability.classic.core import detrended_phase_of, deviation_levels
-from avar.stability.shared.deviation_grids import ESTIMATORS, KERNEL_CODES, deviation_factors, term_ranges
+from avar.stability.classic.core import deviation_levels, phase_parts
+from avar.stability.shared.grids import deviation_factors
+from avar.stability.shared.registry import CLASSIC as ESTIMATORS
+from avar.stability.shared.registry import KERNEL_CODES
+from avar.stability.shared.term_counts import term_ranges
 from tests._support.deviation_reference import exact_variance
 
 NO_LO = np.zeros(1, dtype=np.float32)
@@ -119,7 +122,8 @@ def test_results_do_not_depend_on_the_thread_count():
 def test_hadamard_removes_the_drift():
     """An exactly linear frequency drift (y = 1e3 + i / 2) leaves HDEV at rounding level (1e-32 of ADEV**2)."""
     y = 1e3 + 0.5 * np.arange(100_000.0)
-    hi, lo, scale, mode, bad = detrended_phase_of(y, "freq", "ohdev")
+    parts = phase_parts(y, "freq", "ohdev")
+    hi, scale, mode, bad = parts.hi, parts.scale, parts.mode, parts.bad
     assert mode == 0 and bad is None and np.max(np.abs(hi)) / scale < 1e6  # the drift is gone from the phase
     for estimator in ("hdev", "ohdev"):
         variance, _ = deviation_levels(estimator, y, np.array([1, 10, 100]), "freq")

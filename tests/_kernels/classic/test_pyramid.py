@@ -11,8 +11,10 @@ from avar._kernels.classic.levels import level_sums
 from avar._kernels.classic.phase import scan
 from avar._kernels.classic.pyramid import BLOCK_EXP, MOMENTS, SPLIT_BLOCKS, TAIL, octave_moments
 from avar._kernels.uncertainty.noise_id import ILL_CONDITIONED, lag1_alpha_decimated, lag1_alpha_from_moments
-from avar.stability.classic.core import OctaveMoments, _octave_sums, detrended_phase_of, deviation_levels
-from avar.stability.shared.deviation_grids import KERNEL_CODES, deviation_factors, term_ranges
+from avar.stability.classic.core import OctaveMoments, deviation_levels, octave_sums, phase_parts
+from avar.stability.shared.grids import deviation_factors
+from avar.stability.shared.registry import KERNEL_CODES
+from avar.stability.shared.term_counts import term_ranges
 from avar.stability.uncertainty.noise_id import NOISE_ID_ESTIMATORS, octave_noise, phase_noise
 from tests._support.deviation_reference import exact_variance
 from tests._support.powerlaw import powerlaw_phase
@@ -60,8 +62,9 @@ def test_pyramid_equals_the_general_kernels(estimator, n):
     if n < 4 and estimator == "hdev":
         return
     factors = deviation_factors(estimator, n + 1)
-    sums, counts, scale, moments, _ = _octave_sums(estimator, y, factors, scan(y))
-    hi, lo, scale2, _, _ = detrended_phase_of(y, "freq", estimator)
+    sums, counts, scale, moments, _ = octave_sums(estimator, y, factors, scan(y))
+    parts = phase_parts(y, "freq", estimator)
+    hi, lo, scale2 = parts.hi, parts.lo, parts.scale
     strides, first, last = term_ranges(estimator, n + 1, factors)
     general, general_counts = level_sums(hi, lo, KERNEL_CODES[estimator], factors, strides, first, last)
     np.testing.assert_array_equal(counts, general_counts)
@@ -119,7 +122,7 @@ def test_moments_decide_as_the_two_pass_kernel(estimator):
             for n, kind in ((1000, seed % 3), (20_000, seed % 3), (300_000, seed % 3 if seed < 3 else 0)):
                 y = series(alpha, seed, n, kind)
                 factors = deviation_factors(estimator, n + 1)
-                _, _, _, moments, _ = _octave_sums(estimator, y, factors, scan(y))
+                _, _, _, moments, _ = octave_sums(estimator, y, factors, scan(y))
                 phase = moments.phase()
                 for level, m in enumerate(factors.tolist()):
                     if n // m + 1 < 30:
@@ -141,7 +144,7 @@ def test_octave_noise_equals_the_phase_path(estimator, alpha):
     for kind in (0, 2):
         y = series(alpha, 11, 50_000, kind)
         factors = deviation_factors(estimator, y.size + 1)
-        _, _, _, moments, drift = _octave_sums(estimator, y, factors, scan(y))
+        _, _, _, moments, drift = octave_sums(estimator, y, factors, scan(y))
         dmax = NOISE_ID_ESTIMATORS[estimator]
         got = octave_noise(moments.stats, moments.tails, factors, dmax, drift, moments.phase, moments.clusters)
         want = phase_noise(moments.phase(), factors, dmax, drift, line_free=True)
@@ -180,7 +183,7 @@ def test_r_n_from_clusters_never_builds_the_phase():
         y = np.random.default_rng(seed).standard_normal(200_000)
         for estimator in ("adev", "hdev"):
             factors = deviation_factors(estimator, y.size + 1)
-            _, _, _, moments, drift = _octave_sums(estimator, y, factors, scan(y))
+            _, _, _, moments, drift = octave_sums(estimator, y, factors, scan(y))
             dmax = NOISE_ID_ESTIMATORS[estimator]
             calls = []
 

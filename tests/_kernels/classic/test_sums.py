@@ -7,7 +7,8 @@ import pytest
 
 from avar import _kernels
 from avar.stability.allan.columns import allan_variance_columns
-from avar.stability.shared.grids import averaging_factors, n_differences
+from avar.stability.shared.grids import averaging_factors
+from avar.stability.shared.term_counts import n_differences
 
 
 def numpy_twin(data: np.ndarray, factors: np.ndarray, type: str) -> np.ndarray:

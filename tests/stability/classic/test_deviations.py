@@ -8,7 +8,8 @@ import pandas as pd
 import pytest
 
 import avar
-from avar.stability.shared.deviation_grids import ESTIMATORS, deviation_factors, max_factor
+from avar.stability.shared.grids import deviation_factors, max_factor
+from avar.stability.shared.registry import CLASSIC as ESTIMATORS
 from tests._support.deviation_reference import exact_variance, fsum_variance, nbs14_1000
 from tests._support.paths import STABLE32
 

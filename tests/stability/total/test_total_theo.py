@@ -12,9 +12,10 @@ import avar
 from avar._kernels.total.fft import autocorrelation
 from avar._kernels.total.theobr import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
 from avar._kernels.total.windows import htot_sum, mtot_sum, theo1_sum
+from avar.stability.shared.grids import total_factors
 from avar.stability.total.theoh import theobr_factor
 from avar.stability.uncertainty.edf import estimator_edf
-from avar.stability.uncertainty.total_edf import total_edf, total_factors
+from avar.stability.uncertainty.total_edf import total_edf
 from tests._support.paths import STABLE32
 
 NO_GAPS = np.zeros(0, dtype=np.int64)
@@ -283,8 +284,8 @@ STABLE32_COUNTS = {"mtotdev": {1: 999, 2: 996, 16: 954, 256: 234}, "htotdev": {1
 
 @pytest.mark.parametrize("n_phase, table", [(1001, STABLE32_HTOTDEV), (1253, STABLE32_HTOTDEV_SR87)])
 def test_stable32_htotdev_bounds_and_term_counts(n_phase, table):
+    from avar.stability.shared.term_counts import term_counts
     from avar.stability.uncertainty.edf import chi2_bounds, simple_edf
-    from avar.stability.uncertainty.total_edf import term_counts
 
     rows = np.array(table)
     factors, alpha = rows[:, 0].astype(int), rows[:, 2].astype(int)

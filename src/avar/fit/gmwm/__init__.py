@@ -8,6 +8,7 @@
 * :mod:`avar.fit.gmwm.selection`: :func:`select_model`.
 """
 
-from avar.fit.gmwm.estimator import empirical_allan_variance, fit_allan_variance, gmwm, octave_factors
+from avar.fit.gmwm.estimator import empirical_allan_variance, fit_allan_variance, gmwm
+from avar.stability.shared.grids import octave_factors
 
 __all__ = ["gmwm", "octave_factors", "empirical_allan_variance", "fit_allan_variance"]

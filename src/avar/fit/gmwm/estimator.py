@@ -21,20 +21,12 @@ from avar.imu import ACCELEROMETER, GYROSCOPE, IMU
 from avar.recording import Recording
 from avar.stability.allan.estimator import avar as allan_variance
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
+from avar.stability.shared.grids import octave_factors
 
-__all__ = ["gmwm", "octave_factors", "empirical_allan_variance", "fit_allan_variance"]
+__all__ = ["gmwm", "empirical_allan_variance", "fit_allan_variance"]
 
 #: Replicates of the parametric bootstrap behind ``weights="full"``.
 FULL_REPLICATES = 200
-
-
-def octave_factors(n: int) -> np.ndarray:
-    """m = 1, 2, 4, ..., 2**J with J = floor(log2 N) - 1: the octave grid of :func:`avar.avar` plus m = 1.
-
-    >>> octave_factors(100).tolist()
-    [1, 2, 4, 8, 16, 32]
-    """
-    return 2 ** np.arange(0, int(n).bit_length() - 1, dtype=np.int64)
 
 
 def gmwm(

@@ -25,7 +25,8 @@ from avar.imu import IMU
 from avar.stability.allan.columns import allan_variance_columns
 from avar.stability.allan.intervals import check_ci, chi2_band, relative_errors
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
-from avar.stability.shared.grids import averaging_factors, check_type, n_differences
+from avar.stability.shared.grids import averaging_factors, check_type
+from avar.stability.shared.term_counts import n_differences
 
 
 def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octave", ci: str = "r",

@@ -19,7 +19,7 @@ if TYPE_CHECKING:  # pandas loads with the first table
 
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
-from avar.stability.uncertainty.chi2 import format_confidence
+from avar.stability.shared.confidence import format_confidence
 
 TYPE_NAMES = {"mo": "maximal overlap", "to": "tau overlap"}
 SUMMARY_COLUMNS = ["Time", "AVar", "ADev", "Lower CI", "Upper CI"]
@@ -38,8 +38,10 @@ class AllanVariance:
 
     Attributes
     ----------
+    taus : ndarray
+        (property) Averaging times tau = m / freq, in seconds (the unit of ``1 / freq``).
     levels : ndarray
-        Averaging times tau = m / freq, in seconds (the unit of ``1 / freq``).
+        The same averaging times under R's name.
     averaging_factors : ndarray of int64
         Cluster sizes m (samples per average).
     allan : ndarray
@@ -53,8 +55,10 @@ class AllanVariance:
         Maximal overlap or tau overlap estimator.
     freq : float
         Sampling frequency in Hz (samples per unit of time).
+    n_samples : int
+        (property) Length of the series.
     n : int
-        Length of the series.
+        The same length under R's name.
     name : str or None
         Optional label (the channel name for IMU data).
     ci : {"r", "chi2"}
@@ -135,6 +139,16 @@ class AllanVariance:
             raise ValueError("edf must be > 0 and 0 <= chi2_lci <= chi2_uci at every level")
 
     @property
+    def taus(self) -> np.ndarray:
+        """Averaging times tau (s) of the levels (R's name: ``levels``)."""
+        return self.levels
+
+    @property
+    def n_samples(self) -> int:
+        """Length of the series (R's name: ``n``)."""
+        return self.n
+
+    @property
     def adev(self) -> np.ndarray:
         """Allan deviation sqrt(allan), in data units."""
         return np.sqrt(self.allan)
@@ -212,7 +226,9 @@ class ImuAllanVariance:
     freq : float
         Sampling frequency in Hz.
     n : int
-        Samples per channel.
+        Samples per channel (also ``n_samples``).
+    taus : ndarray
+        (property) Averaging times tau (s) of the levels, shared by the channels.
     channels : Mapping[str, AllanVariance]
         One Allan variance per channel, in channel order.
     sensor_types : tuple of str
@@ -239,6 +255,17 @@ class ImuAllanVariance:
         set_field(self, "n", int(self.n))
         if not len(self.channels) == len(self.sensor_types) == len(self.axes):
             raise ValueError("channels, sensor_types and axes must have one entry per channel")
+
+    @property
+    def taus(self) -> np.ndarray:
+        """Averaging times tau (s) of the levels: the channels' common grid (the longest channel's when
+        their lengths differ; each channel's own is ``channels[name].taus``)."""
+        return max((av.levels for av in self.channels.values()), key=len, default=np.zeros(0))
+
+    @property
+    def n_samples(self) -> int:
+        """Samples per channel (R's name: ``n``)."""
+        return self.n
 
     @property
     def type(self) -> str:

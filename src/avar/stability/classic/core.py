@@ -22,7 +22,8 @@ from avar._kernels.classic.levels import detrended_phase, level_sums, scan
 from avar._kernels.classic.phase import centred_moment
 from avar._kernels.classic.pyramid import MOMENTS, SUM_COLUMN, TAIL, octave_moments
 from avar._kernels.uncertainty.noise_id import rn_clusters
-from avar.stability.shared.deviation_grids import KERNEL_CODES, term_counts, term_ranges
+from avar.stability.shared.registry import KERNEL_CODES
+from avar.stability.shared.term_counts import term_counts, term_ranges
 
 #: Denominator constant of every estimator: sigma^2 = sum / (K m^2 tau0^2 n) (MDEV: K m^4 tau0^2 n).
 _K = {"adev": 2.0, "oadev": 2.0, "mdev": 2.0, "tdev": 2.0, "hdev": 6.0, "ohdev": 6.0, "totdev": 2.0}
@@ -72,6 +73,30 @@ def _scale(low: float, high: float, origin: float) -> float:
     return float(np.ldexp(1.0, -int(np.clip(exponent, -1000, 1000))))
 
 
+class PhaseParts(NamedTuple):
+    """The compensated, detrended, scaled phase of the data and what the kernels need (:func:`phase_parts`)."""
+
+    hi: np.ndarray
+    lo: np.ndarray
+    scale: float
+    mode: int
+    bad: np.ndarray | None
+    phase: np.ndarray
+    drift: float
+    line: float | None
+
+
+class LevelsAndPhase(NamedTuple):
+    """Variances and term counts of every level, and what the noise identification needs
+    (:func:`deviation_levels_and_phase`)."""
+
+    variance: np.ndarray
+    n_terms: np.ndarray
+    phase: np.ndarray | OctaveMoments
+    drift: float
+    line: float | None
+
+
 class OctaveMoments(NamedTuple):
     """What the noise identification of the pyramid's levels needs (see :mod:`avar._kernels.classic.pyramid`).
 
@@ -88,7 +113,7 @@ class OctaveMoments(NamedTuple):
     clusters: Callable[[int], tuple[np.ndarray, np.ndarray]]
 
 
-def _octave_sums(estimator: str, data: np.ndarray, factors: np.ndarray, scanned: tuple):
+def octave_sums(estimator: str, data: np.ndarray, factors: np.ndarray, scanned: tuple):
     """ADEV/HDEV of gap-free frequency data at m = 1, 2, 4, ... by the Haar pyramid
     (:mod:`avar._kernels.classic.pyramid`): ``sums, counts, scale, moments, drift``."""
     _, total, low, high, moment = scanned
@@ -103,7 +128,7 @@ def _octave_sums(estimator: str, data: np.ndarray, factors: np.ndarray, scanned:
     sums = np.ascontiguousarray(stats[:, SUM_COLUMN[order]])
 
     def phase() -> np.ndarray:
-        return phase_parts(data, "freq", estimator, scanned)[5]
+        return phase_parts(data, "freq", estimator, scanned).phase
 
     def clusters(step: int) -> tuple[np.ndarray, np.ndarray]:
         z = np.empty(count // step + 1)
@@ -119,12 +144,7 @@ def _is_octave(factors: np.ndarray) -> bool:
     return bool(factors.size) and bool(np.array_equal(factors, 2 ** np.arange(factors.size, dtype=np.int64)))
 
 
-def detrended_phase_of(data: np.ndarray, data_type: str, estimator: str):
-    """The compensated, detrended, scaled phase of ``data`` and what the kernels need (see :func:`phase_parts`)."""
-    return phase_parts(data, data_type, estimator)[:5]
-
-
-def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple | None = None):
+def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple | None = None) -> PhaseParts:
     """The compensated, detrended, scaled phase of ``data`` and what the kernels need.
 
     Returns ``hi, lo, scale, mode, bad``: the phase ``(hi + lo) / scale`` (in
@@ -163,7 +183,7 @@ def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple
         detrended_phase(hi, lo, 2, float(np.mean(hi)), 0.0, 1.0, running_hi, running_lo)
         hi, lo = running_hi, running_lo
     mode = 0 if bad is None else (1 if is_phase else 2)
-    return hi, lo, scale, mode, bad, phase, slope * scale, (centre * scale if is_phase else None)
+    return PhaseParts(hi, lo, scale, mode, bad, phase, slope * scale, (centre * scale if is_phase else None))
 
 
 def deviation_levels(
@@ -199,11 +219,12 @@ def deviation_levels(
     >>> variance.tolist(), n.tolist()
     ([0.5, 0.0], [4, 2])
     """
-    return deviation_levels_and_phase(estimator, data, factors, data_type, rate)[:2]
+    levels = deviation_levels_and_phase(estimator, data, factors, data_type, rate)
+    return levels.variance, levels.n_terms
 
 
 def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str = "phase",
-                               rate: float = 1.0, scanned: tuple | None = None):
+                               rate: float = 1.0, scanned: tuple | None = None) -> LevelsAndPhase:
     """:func:`deviation_levels` and what the noise identification needs.
 
     Returns ``variance, n, phase, drift, line``: ``phase`` the detrended phase it
@@ -215,7 +236,7 @@ def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.nda
     n_phase = data.shape[0] + (data_type == "freq")
     scanned = scan(data) if scanned is None else scanned
     if estimator in ("adev", "hdev") and data_type == "freq" and scanned[0] == 0 and _is_octave(factors):
-        sums, counts, scale, phase, drift = _octave_sums(estimator, data, factors, scanned)
+        sums, counts, scale, phase, drift = octave_sums(estimator, data, factors, scanned)
         line = None
     else:
         hi, lo, scale, mode, bad, phase, drift, line = phase_parts(data, data_type, estimator, scanned)
@@ -231,4 +252,4 @@ def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.nda
             tau = m / rate
             variance = variance * tau * tau / 3.0
     variance[counts == 0] = np.nan
-    return variance, counts, phase, drift, line
+    return LevelsAndPhase(variance, counts, phase, drift, line)

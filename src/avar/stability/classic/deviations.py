@@ -31,10 +31,12 @@ import numpy as np
 
 from avar.stability.classic.core import OctaveMoments, deviation_levels_and_phase
 from avar.stability.shared.deviation import Deviation
-from avar.stability.shared.deviation_grids import MIN_PHASE_POINTS, deviation_factors, levels_with_terms
 from avar.stability.shared.docstrings import fill_parameters
+from avar.stability.shared.grids import deviation_factors
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE, check_data, check_options, scaled
 from avar.stability.shared.noise_types import ALPHA_PARAMETER, check_alpha
+from avar.stability.shared.registry import MIN_PHASE_POINTS
+from avar.stability.shared.term_counts import levels_with_terms
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES
 from avar.stability.uncertainty.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 from avar.stability.uncertainty.noise_id import NOISE_ID_ESTIMATORS, identify_noise, octave_noise, phase_noise
@@ -90,7 +92,7 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     rate = check_options(estimator, data, rate, data_type, confidence, nan_policy)
     drift_removed = estimator in ("hdev", "ohdev") and data_type == "freq"  # the scan finds the drift too
     values, scanned = check_data(data, data_type, nan_policy, weigh=drift_removed)
-    n_missing = int(scanned[0])
+    n_missing = int(scanned.n_missing)
     n_phase = values.size + (data_type == "freq")
     needed = MIN_PHASE_POINTS[estimator] - (data_type == "freq")
     if values.size < needed:

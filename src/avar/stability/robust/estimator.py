@@ -20,7 +20,8 @@ from avar.imu import IMU
 from avar.stability.allan.columns import allan_variance_columns
 from avar.stability.allan.intervals import relative_errors
 from avar.stability.robust.results import Outliers, RobustAllanVariance
-from avar.stability.shared.grids import averaging_factors, n_differences
+from avar.stability.shared.grids import averaging_factors
+from avar.stability.shared.term_counts import n_differences
 
 #: 1 / Phi^{-1}(3/4): the MAD of a Gaussian times this is its standard deviation.
 MAD_TO_SD = 1.482602218505602

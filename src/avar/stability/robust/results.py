@@ -27,7 +27,7 @@ class Outliers:
     indices : ndarray of int64
         Their positions (0-based, increasing).
     n : int
-        Length of the series.
+        Length of the series (also ``n_samples``).
     threshold : float
         The flagging threshold, in robust standard deviations.
     scale : float
@@ -43,6 +43,11 @@ class Outliers:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "indices", frozen_array(self.indices, np.int64))
+
+    @property
+    def n_samples(self) -> int:
+        """Length of the series (the same as ``n``)."""
+        return self.n
 
     @property
     def fraction(self) -> float:

@@ -13,15 +13,8 @@ import pandas as pd
 
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
-from avar.stability.shared.deviation_grids import ESTIMATORS as _FAMILY
-from avar.stability.shared.deviation_grids import LONG_NAMES as _FAMILY_NAMES
-from avar.stability.shared.registry import DEVIATION_STATISTICS, EXTRA_LONG_NAMES, PAIR_STATISTICS
-from avar.stability.uncertainty.chi2 import format_confidence
-from avar.stability.uncertainty.total_edf import TOTAL_ESTIMATORS, TOTAL_LONG_NAMES
-
-#: Every estimator with its own variance core: the family and the total and Theo statistics.
-ESTIMATORS = (*_FAMILY, *TOTAL_ESTIMATORS)
-LONG_NAMES = {**_FAMILY_NAMES, **TOTAL_LONG_NAMES, **EXTRA_LONG_NAMES}
+from avar.stability.shared.confidence import format_confidence
+from avar.stability.shared.registry import LONG_NAMES, STATISTICS
 
 #: Columns of :meth:`Deviation.summary`, in the order of Stable32's run table.
 SUMMARY_COLUMNS = ["Tau", "m", "N terms", "Alpha", "Min sigma", "Sigma", "Max sigma", "EDF"]
@@ -50,8 +43,10 @@ class Deviation:
         The deviation (dimensionless; TDEV in seconds).
     variance : ndarray
         Its square.
+    n_terms : ndarray of int64
+        (property) Number of terms averaged at each level (Stable32's ``#``).
     n : ndarray of int64
-        Number of terms averaged at each level (Stable32's ``#``).
+        The same term counts (``n_terms``'s older name).
     alpha : ndarray of int64
         Identified power-law noise exponent, S_y(f) ~ f**alpha (2 white PM,
         1 flicker PM, 0 white FM, -1 flicker FM, -2 random-walk FM).
@@ -96,7 +91,7 @@ class Deviation:
         names = ("taus", "averaging_factors", "deviation", "variance", "n", "alpha", "edf", "lci", "uci")
         if len({len(getattr(self, name)) for name in names}) != 1:
             raise ValueError(f"{', '.join(names)} must have one length")
-        known = (*ESTIMATORS, *DEVIATION_STATISTICS, *PAIR_STATISTICS)
+        known = tuple(STATISTICS)
         if self.estimator not in known:
             raise ValueError(f"estimator must be one of {sorted(set(known))}, got {short_repr(self.estimator)}")
         if self.data_type not in ("phase", "freq"):
@@ -106,6 +101,11 @@ class Deviation:
         set_field(self, "confidence", float(self.confidence))
 
     @property
+    def n_terms(self) -> np.ndarray:
+        """Number of terms averaged at each level (Stable32's ``#``; also ``n``)."""
+        return self.n
+
+    @property
     def name(self) -> str:
         """The estimator's upper-case name, e.g. ``"OADEV"``."""
         return self.estimator.upper()
@@ -113,7 +113,7 @@ class Deviation:
     @property
     def long_name(self) -> str:
         """The statistic's long name, e.g. ``"overlapping Allan deviation"``."""
-        return LONG_NAMES.get(self.estimator) or EXTRA_LONG_NAMES.get(self.estimator, self.estimator)
+        return LONG_NAMES.get(self.estimator, self.estimator)
 
     def __len__(self) -> int:
         return len(self.taus)

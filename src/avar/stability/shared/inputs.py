@@ -8,23 +8,48 @@ below trust what they are given.
 from __future__ import annotations
 
 import numbers
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
 
 from avar._kernels.classic.phase import scan
 from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, rate_from_index, short_repr
-from avar.stability.uncertainty.chi2 import DEFAULT_CONFIDENCE
+from avar.stability.shared.confidence import DEFAULT_CONFIDENCE
 
 __all__ = ["DATA_TYPES", "DEFAULT_CONFIDENCE", "NAN_POLICIES", "SCALE_LIMIT", "TINY_LIMIT", "check_data", "check_not_tiny",
            "check_options", "rate_of", "scaled"]
 
 DATA_TYPES = ("freq", "phase")
+
+
+class Scan(NamedTuple):
+    """One pass over the data (:func:`avar._kernels.classic.phase.scan`)."""
+
+    n_missing: int
+    total: float
+    low: float
+    high: float
+    moment: float
+
+
+class CheckedData(NamedTuple):
+    """Float64 values of the data and their :class:`Scan`."""
+
+    values: np.ndarray
+    scanned: Scan | None
+
+
+class ScaledData(NamedTuple):
+    """Data scaled by 2**-exponent to magnitude ~1 (exponent 0: unscaled), with their :class:`Scan`."""
+
+    values: np.ndarray
+    scanned: Scan
+    exponent: int
 NAN_POLICIES = ("raise", "omit")
 
 
-def check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False) -> tuple[np.ndarray, tuple]:
+def check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False) -> CheckedData:
     """Float64 values of ``data`` and their :func:`scan` (NaN count, sum, min, max, and with
     ``weigh`` the centred moment), or an error naming ``data``."""
     if isinstance(data, pd.DataFrame):
@@ -40,19 +65,19 @@ def check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False) 
     values = np.ascontiguousarray(as_float64(array), dtype=np.float64)
     if not values.flags.writeable:  # one compiled signature of the kernels
         values = values.copy()
-    scanned = scan(values, weigh=weigh) if values.size else (0, 0.0, np.inf, -np.inf, np.nan)  # one pass
-    if np.isinf(scanned[2]) and scanned[0] < values.size or np.isinf(scanned[3]) and scanned[0] < values.size:
+    scanned = Scan(*scan(values, weigh=weigh)) if values.size else Scan(0, 0.0, np.inf, -np.inf, np.nan)  # one pass
+    if (np.isinf(scanned.low) or np.isinf(scanned.high)) and scanned.n_missing < values.size:
         infinite = np.flatnonzero(np.isinf(values))
         raise ValueError(f"data has {infinite.size} infinite value(s), the first at index {infinite[0]}; "
                          "infinite values are never accepted (NaN marks a gap, see nan_policy)")
-    n_missing = int(scanned[0])
+    n_missing = int(scanned.n_missing)
     if n_missing and nan_policy == "raise":
         missing = np.flatnonzero(np.isnan(values))
         raise ValueError(f"data has {n_missing} NaN value(s), the first at index {missing[0]}; pass "
                          "nan_policy='omit' to skip the terms that touch them, or remove/fill them")
     if n_missing == values.size:
         raise ValueError("data holds only NaN values")
-    return values, scanned
+    return CheckedData(values, scanned)
 
 
 def rate_of(data: Any, rate: Any) -> float:
@@ -86,34 +111,34 @@ def check_options(estimator: str, data: Any, rate: Any, data_type: Any, confiden
 SCALE_LIMIT = 400
 
 
-def scaled(values: np.ndarray, scanned: tuple, weigh: bool) -> tuple[np.ndarray, tuple, int]:
+def scaled(values: np.ndarray, scanned: Scan, weigh: bool) -> ScaledData:
     """``values`` scaled by 2**-e to magnitude ~1 when near the float64 limits (squares of data near
     1e-300 underflow to 0, of data near 1e300 overflow), with their scan and e (0: unscaled).
 
     The deviation is then exact; the variance is its square correctly rounded (0 or subnormal for
     data near 1e-300), and a variance beyond the float64 maximum is an error."""
-    big = max(abs(float(scanned[2])), abs(float(scanned[3])))
+    big = max(abs(float(scanned.low)), abs(float(scanned.high)))
     if not np.isfinite(big) or big == 0 or 2.0 ** -SCALE_LIMIT < big < 2.0 ** SCALE_LIMIT:
-        return values, scanned, 0
+        return ScaledData(values, scanned, 0)
     exponent = int(np.frexp(big)[1])
     values = np.ldexp(values, -exponent)
-    return values, scan(values, weigh=weigh), exponent
+    return ScaledData(values, Scan(*scan(values, weigh=weigh)), exponent)
 
 
 #: Data below 2**-TINY_LIMIT in magnitude have variances at the bottom of float64 (about 1e-302 and less).
 TINY_LIMIT = 500
 
 
-def check_not_tiny(statistic: str, scanned: tuple) -> None:
+def check_not_tiny(statistic: str, scanned: Scan) -> None:
     """An error for data below 2**-TINY_LIMIT in magnitude (but not all zero), for the statistics
     that do not rescale them (their variance would underflow to 0: a zero deviation, silently).
 
-    >>> check_not_tiny("mtotdev", (0, 0.0, -1e-300, 1e-300, np.nan))
+    >>> check_not_tiny("mtotdev", Scan(0, 0.0, -1e-300, 1e-300, np.nan))
     Traceback (most recent call last):
     ...
     ValueError: data of magnitude 1e-300 is below the float64 range of mtotdev's variance; rescale the data, e.g. to other units
     """
-    big = max(abs(float(scanned[2])), abs(float(scanned[3])))
+    big = max(abs(float(scanned.low)), abs(float(scanned.high)))
     if np.isfinite(big) and 0 < big < 2.0 ** -TINY_LIMIT:
         raise ValueError(f"data of magnitude {big:.3g} is below the float64 range of {statistic}'s variance; "
                          "rescale the data, e.g. to other units")

@@ -131,7 +131,7 @@ def psd(data: Any, rate: float = 1.0, data_type: str = "freq", method: str = "we
 
 
 def psd_to_deviation(frequencies: Any, psd: Any, taus: Any, kind: str = "adev", rate: float | None = None) -> np.ndarray:
-    """Deviation implied by a one-sided frequency PSD: sigma**2(tau) = integral S_y(f) |H(f)|**2 df.
+    """Deviation implied by a one-sided frequency PSD: sigma**2(tau) = integral S_y(f) ``|H(f)|**2`` df.
 
     The transfer functions (NIST SP 1065 section 7.1, Barnes et al. 1971)::
 

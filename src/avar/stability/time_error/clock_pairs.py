@@ -135,7 +135,7 @@ def gcodev(data_1: Any, data_2: Any, rate: float | None = None, data_type: str =
     and x2 that of B against C (or C against B: the sign flips), GCOV
     estimates -sigma_B**2 (+sigma_B**2), free of the two measurements'
     independent noise. ``variance`` is GCOV, signed; ``deviation`` is
-    sign(GCOV) sqrt(|GCOV|) (``allantools.gcodev`` returns sqrt(|GCOV|)).
+    sign(GCOV) sqrt(``|GCOV|``) (``allantools.gcodev`` returns sqrt(``|GCOV|``)).
     No chi-squared bounds (``edf``, ``lci``, ``uci`` are NaN); ``alpha`` is
     that of ``data_1`` (or the one given).
 

@@ -10,23 +10,31 @@ identifying it (as Stable32 allows).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from avar._kernels.time_error import mtie_levels, pdev_levels, tierms_levels
 from avar.stability.classic.deviations import noise_exponents, noise_of_levels
 from avar.stability.shared.deviation import Deviation
-from avar.stability.shared.deviation_grids import levels_with_terms
 from avar.stability.shared.docstrings import fill_parameters
-from avar.stability.shared.grids import grid_factors
+from avar.stability.shared.grids import grid_factors, largest_factor
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE, check_data, check_not_tiny, check_options
 from avar.stability.shared.noise_types import ALPHA_PARAMETER, check_alpha
+from avar.stability.shared.term_counts import levels_with_terms
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES
 from avar.stability.uncertainty.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 
 
-def prepared_phase(values: np.ndarray, data_type: str, rate: float) -> tuple[np.ndarray, np.ndarray, int]:
+class PreparedPhase(NamedTuple):
+    """Gap-filled phase, the running count of missing values and the kernels' ``extra``."""
+
+    phase: np.ndarray
+    gaps: np.ndarray
+    extra: int
+
+
+def prepared_phase(values: np.ndarray, data_type: str, rate: float) -> PreparedPhase:
     """Gap-filled phase, the running count of missing values and the kernels' ``extra``.
 
     Phase data: gaps filled by linear interpolation (small increments), ``extra`` = 1.
@@ -40,19 +48,10 @@ def prepared_phase(values: np.ndarray, data_type: str, rate: float) -> tuple[np.
             good = np.flatnonzero(~missing)
             phase = values.copy()
             phase[missing] = np.interp(np.flatnonzero(missing), good, values[good])
-        return np.ascontiguousarray(phase, dtype=np.float64), gaps, 1
+        return PreparedPhase(np.ascontiguousarray(phase, dtype=np.float64), gaps, 1)
     centred = np.where(missing, 0.0, values - np.nanmean(values))
     phase = np.concatenate(([0.0], np.cumsum(centred))) / rate
-    return phase, gaps, 0
-
-
-def largest_factor(statistic: str, n_phase: int) -> int:
-    """Largest m with at least one term: N - 1 (MTIE, TIE rms), floor((N - 1) / 2) (PDEV).
-
-    >>> largest_factor("mtie", 101), largest_factor("pdev", 101)
-    (100, 50)
-    """
-    return max(0, (n_phase - 1) // 2) if statistic == "pdev" else max(0, n_phase - 1)
+    return PreparedPhase(phase, gaps, 0)
 
 
 def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, confidence: Any,

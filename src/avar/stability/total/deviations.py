@@ -23,20 +23,13 @@ from avar._kernels.total.windows import level_sums, theo1_sum
 from avar.stability.classic.core import phase_parts
 from avar.stability.classic.deviations import noise_exponents
 from avar.stability.shared.deviation import Deviation
-from avar.stability.shared.deviation_grids import levels_with_terms
+from avar.stability.shared.grids import largest_factor, total_factors
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE, check_data, check_not_tiny, check_options
 from avar.stability.shared.noise_types import ALPHA_PARAMETER, check_alpha
+from avar.stability.shared.term_counts import levels_with_terms, term_counts
 from avar.stability.total.theobr import MIN_THEOBR_POINTS, theobr_factor
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES, chi2_bounds
-from avar.stability.uncertainty.total_edf import (
-    MTOT_EDF,
-    htot_bias,
-    largest_factor,
-    term_counts,
-    theo1_bias,
-    total_edf,
-    total_factors,
-)
+from avar.stability.uncertainty.total_edf import MTOT_EDF, htot_bias, theo1_bias, total_edf
 
 #: MTOTVAR / MVAR per noise type (Howe and Vernotte 1999; Riley, "CI2"), applied on request only.
 MTOT_BIAS = {2: 0.94, 1: 0.83, 0: 0.73, -1: 0.70, -2: 0.69}

@@ -7,6 +7,8 @@ than white FM.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from avar._kernels.total.fft import autocorrelation
@@ -31,7 +33,14 @@ KF_REACH = 16
 KF_ALLAN_REACH = 8
 
 
-def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[float, int]:
+class TheoBRFactor(NamedTuple):
+    """TheoBR's bias factor kf and the n it averages over."""
+
+    kf: float
+    n: int
+
+
+def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> TheoBRFactor:
     """TheoBR's bias factor kf = 1 / (n + 1) sum_{i=0}^{n} AVAR(9 + 3i) / Theo1(12 + 4i),
     n = floor(N / 6) - 3 (both at tau = (9 + 3i) tau0; AVAR overlapping), and n (:func:`theobr_count`).
 
@@ -39,7 +48,7 @@ def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[fl
     The units cancel in the ratio.
     """
     terms, n = theobr_terms(x, autocorr)
-    return float(np.mean(terms)), n
+    return TheoBRFactor(float(np.mean(terms)), n)
 
 
 def theobr_count(n_points: int) -> int:

@@ -20,14 +20,14 @@ from avar._kernels.total.theobr import oavar_sums
 from avar._kernels.total.windows import theo1_sum
 from avar.stability.classic.deviations import noise_exponents
 from avar.stability.shared.deviation import Deviation
-from avar.stability.shared.deviation_grids import deviation_factors
+from avar.stability.shared.grids import deviation_factors, total_factors
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE
 from avar.stability.shared.noise_types import check_alpha
 from avar.stability.total.deviations import prepared_phase
 from avar.stability.total.theobr import MIN_THEOBR_POINTS, theobr_factor
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES
 from avar.stability.uncertainty.edf import chi2_bounds, estimator_edf
-from avar.stability.uncertainty.total_edf import total_edf, total_factors
+from avar.stability.uncertainty.total_edf import total_edf
 
 #: Stable32's ThêoH table: OADEV at its own factors (m <= N / 4) and Theo1 from m = floor(N / THEO_FROM).
 THEO_FROM = 5

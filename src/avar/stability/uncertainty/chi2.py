@@ -20,7 +20,7 @@ Two ways to get the quantiles chi2_p(edf):
   p <= 1/2, where Stable32 has a1 = 0.27601 (the handbook's 0.27061 with two
   digits swapped). Its bounds differ from the exact ones by at most about 5e-4
   (relative) and reproduce Stable32's printed bounds to their 5 digits
-  (``tests/stability/test_chi2.py``).
+  (``tests/stability/uncertainty/test_chi2.py``).
 
 The deviation catalogue (``avar.adev`` ... ``avar.theoh``) uses Stable32's
 quantiles, to print what Stable32 prints; the Allan variance's chi-squared band
@@ -30,19 +30,13 @@ and the noise report use the exact ones. Either set is one call away:
 
 from __future__ import annotations
 
-import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from avar._validation import short_repr
+from avar.stability.shared.confidence import DEFAULT_CONFIDENCE, ONE_SIGMA, format_confidence  # noqa: F401 (re-exported)
 
-#: One standard deviation, erf(1 / sqrt(2)) = 0.682689...: the default confidence. Stable32 prints
-#: it as "Confidence Factor = 0.683" and computes with the exact value: its printed bounds are
-#: reproduced with this, not with 0.683, whose intervals are as wide as one sigma's with 0.15 %
-#: fewer degrees of freedom (``tests/stability/test_chi2.py``).
-ONE_SIGMA = math.erf(1.0 / math.sqrt(2.0))
-DEFAULT_CONFIDENCE = ONE_SIGMA
 QUANTILES = ("exact", "stable32")
 #: The quantiles of the deviation catalogue's bounds: Stable32's, to print what it prints.
 CATALOGUE_QUANTILES = "stable32"
@@ -52,8 +46,15 @@ STABLE32_EXACT_UP_TO = 100.0
 STABLE32_NORMAL_QUANTILE = (2.30753, 0.27601, 0.99229, 0.04481)
 
 
+class Bounds(NamedTuple):
+    """Lower and upper confidence bounds of a deviation (its units)."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+
+
 def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE,
-                quantiles: str = "exact") -> tuple[np.ndarray, np.ndarray]:
+                quantiles: str = "exact") -> Bounds:
     """Chi-squared confidence bounds of a deviation with ``edf`` degrees of freedom.
 
     ``lci = deviation sqrt(edf / chi2.isf(q, edf))`` and ``uci = deviation
@@ -117,7 +118,7 @@ def chi2_bounds(deviation: Any, edf: Any, confidence: float = DEFAULT_CONFIDENCE
             z = _stable32_upper_normal_quantile(tail)
             upper[large], lower[large] = _wilson_hilferty(edf[large], z), _wilson_hilferty(edf[large], -z)
         lci, uci = deviation * np.sqrt(edf / upper), deviation * np.sqrt(edf / lower)
-        return np.minimum(lci, deviation), np.maximum(uci, deviation)
+        return Bounds(np.minimum(lci, deviation), np.maximum(uci, deviation))
 
 
 def _stable32_upper_normal_quantile(tail: float) -> float:
@@ -140,12 +141,3 @@ def _real_array(values: Any, name: str) -> np.ndarray:
     if array.dtype.kind not in "iuf" or isinstance(values, (bool, np.bool_)):
         raise TypeError(f"{name} must be a real number or array, got {short_repr(values)}")
     return array.astype(np.float64)
-
-
-def format_confidence(confidence: float) -> str:
-    """A confidence level as printed: one sigma as Stable32 prints it (0.683), any other as given.
-
-    >>> format_confidence(ONE_SIGMA), format_confidence(0.95), format_confidence(0.9973)
-    ('0.683', '0.95', '0.9973')
-    """
-    return "0.683" if confidence == ONE_SIGMA else f"{confidence:g}"

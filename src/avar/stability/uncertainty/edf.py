@@ -343,10 +343,10 @@ def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phas
 def gap_scaled_edf(edf: np.ndarray, used: np.ndarray, estimator: str, n_phase: int, factors: np.ndarray) -> np.ndarray:
     """EDF of levels that lost terms to gaps: scaled by the fraction of terms used, never below 1.
 
-    ``used`` terms of the gap-free count (:func:`avar.stability.shared.deviation_grids.term_counts`)
+    ``used`` terms of the gap-free count (:func:`avar.stability.shared.term_counts.term_counts`)
     remain at each level; one Gaussian term is one degree of freedom, the floor.
     """
-    from avar.stability.shared.deviation_grids import term_counts
+    from avar.stability.shared.term_counts import term_counts
 
     return np.maximum(edf * used / term_counts(estimator, n_phase, factors), 1.0)
 

@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 
 from avar._validation import short_repr
-from avar.stability.shared.deviation_grids import term_counts
-from avar.stability.uncertainty.total_edf import term_counts as total_term_counts
+from avar.stability.shared.term_counts import term_counts
+from avar.stability.shared.term_counts import term_counts as total_term_counts
 
 #: The lag-1 autocorrelation is used where at least this many frequency averages K = (N - 1) // m remain
 #: (Stable32 switches to B1 at K = 29: its MDEV table of an OCXO's 19,982 readings, m = 659 -> 672).

@@ -18,24 +18,9 @@ Theo1's count is that of its inner terms, as Stable32's ``Thêo1 #`` and
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
-from avar._validation import short_repr
-from avar.stability.shared.grids import grid_factors
 from avar.stability.uncertainty.edf import estimator_edf, stable32_simple_edf
-
-TOTAL_ESTIMATORS = ("mtotdev", "ttotdev", "htotdev", "theo1", "theoh")
-
-#: Long names, for labels and summaries.
-TOTAL_LONG_NAMES = {
-    "mtotdev": "modified total deviation",
-    "ttotdev": "time total deviation",
-    "htotdev": "Hadamard total deviation",
-    "theo1": "Theo1 deviation",
-    "theoh": "ThêoH deviation (OADEV and bias-removed Theo1)",
-}
 
 #: NIST SP 1065 Table 8: MTOTVAR (and TTOTVAR) EDF = b N / m - c.
 MTOT_EDF = {2: (1.90, 2.10), 1: (1.20, 1.40), 0: (1.10, 1.20), -1: (0.85, 0.50), -2: (0.75, 0.31)}
@@ -58,78 +43,6 @@ HTOT_BIAS = {0: -0.005, -1: -0.149, -2: -0.229}
 #: Howe and Tasset 2004, Table 1: AVAR / Theo1 = a + b / r**c, r = 0.75 m.
 THEO1_BIAS = {2: (0.09, 0.74, 0.40), 1: (0.14, 0.82, 0.30), 0: (1.0, 0.0, 0.0), -1: (1.87, -1.05, 0.79),
               -2: (2.70, -1.53, 0.85)}
-
-
-def largest_factor(estimator: str, n_phase: int) -> int:
-    """Largest averaging factor with one term (0 if none).
-
-    >>> [largest_factor(e, 1001) for e in ("mtotdev", "htotdev", "theo1")]
-    [333, 333, 1000]
-    """
-    n = int(n_phase)
-    if estimator in ("mtotdev", "ttotdev"):
-        return max(0, n // 3)
-    if estimator == "htotdev":
-        return max(0, (n - 1) // 3)
-    largest = n - 1
-    return max(0, largest - largest % 2)
-
-
-def term_counts(estimator: str, n_phase: int, factors: Any) -> np.ndarray:
-    """Terms n(m) of every level without gaps, as in the table above.
-
-    >>> term_counts("mtotdev", 100, np.array([1, 33])).tolist(), term_counts("theo1", 100, [2, 98]).tolist()
-    ([98, 2], [98, 98])
-    """
-    m = np.asarray(factors, dtype=np.int64)
-    n = int(n_phase)
-    if estimator in ("mtotdev", "ttotdev"):
-        return n - 3 * m + 1
-    if estimator == "htotdev":
-        return n - 3 * m
-    return (n - m) * (m // 2)
-
-
-def total_factors(estimator: str, n_phase: int, rate: float, taus: Any) -> np.ndarray:
-    """Averaging factors of a tau grid (see :func:`avar.stability.shared.grids.grid_factors`).
-
-    Theo1 (and ThêoH's Theo1 levels) take even m only, tau = 0.75 m tau0:
-    ``"octave"`` m = 2, 4, 8, ...; ``"decade"`` the even ones of 1, 2, 4 x
-    10**k; ``"all"`` every even m; explicit taus in seconds give m = tau /
-    (0.75 tau0), which must be a whole even number.
-
-    >>> total_factors("theo1", 100, 1.0, "octave").tolist(), total_factors("theo1", 100, 1.0, [1.5, 3.0]).tolist()
-    ([2, 4, 8, 16, 32, 64], [2, 4])
-    """
-    largest = largest_factor(estimator, n_phase)
-    context = f"of {estimator} with {n_phase} phase points at rate = {rate:g} Hz"
-    if estimator != "theo1":
-        return grid_factors(taus, rate, largest, first_octave=0, context=f"{context} (m = 1..{largest})")
-    if largest < 2:
-        return np.zeros(0, dtype=np.int64)
-    if isinstance(taus, str):
-        if taus.lower() == "octave":
-            return 2 ** np.arange(1, largest.bit_length(), dtype=np.int64)
-        factors = grid_factors(taus, rate, largest, first_octave=1, context=context)
-        return factors[(factors % 2 == 0)]
-    try:
-        given = np.asarray(taus, dtype=np.float64)
-        scaled = given / 0.75
-    except (TypeError, ValueError):
-        scaled = taus  # grid_factors names what is wrong
-    else:  # the range in Theo1's own taus, not in the m they stand for
-        low, high = 1.5 / rate, 0.75 * (largest - largest % 2) / rate
-        outside = np.atleast_1d((given < low * (1 - 1e-9)) | (given > high * (1 + 1e-9)))
-        if given.ndim <= 1 and outside.any():
-            raise ValueError(f"taus {short_repr(np.atleast_1d(given)[outside].tolist())} are outside the valid range "
-                             f"[{low:g}, {high:g}] s {context} (tau = 0.75 m / rate, m even)")
-    exact = grid_factors(scaled, rate, largest, first_octave=1, context=f"{context} (tau = 0.75 m / rate, m even)")
-    requested = np.atleast_1d(scaled) * rate
-    odd = (np.abs(requested - np.round(requested)) > 1e-9 * requested) | (np.round(requested) % 2 == 1)
-    if odd.any():
-        raise ValueError(f"theo1 taus must be 0.75 m / rate with m even, got {short_repr((requested[odd] * 0.75 / rate).tolist())} "
-                         f"s (m = {short_repr(requested[odd].tolist())})")
-    return exact
 
 
 def total_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phase: int,
