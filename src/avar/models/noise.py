@@ -30,7 +30,7 @@ def filter_coefficients(alpha: float, n: int) -> np.ndarray:
 def discrete_psd(frequencies: Any, alpha: float, h: float = 1.0, rate: float = 1.0) -> np.ndarray:
     """The exact one-sided PSD of :func:`power_law`'s frequency series, S_y(f) (1/Hz).
 
-    S_y(f) = 2 Q tau0 |2 sin(pi f tau0)|**alpha, Q = h (2 pi)**(-alpha) / (2 tau0**(alpha + 1)),
+    S_y(f) = 2 Q tau0 ``|2 sin(pi f tau0)|**alpha``, Q = h (2 pi)**(-alpha) / (2 tau0**(alpha + 1)),
     so that S_y(f) -> h f**alpha where f << 1 / tau0 (Kasdin and Walter 1992, eq. 14).
 
     >>> round(float(discrete_psd([1e-4], -1, h=3.0)[0] * 1e-4), 6)  # flicker FM: h_-1 / f

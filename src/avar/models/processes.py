@@ -363,7 +363,7 @@ class DR(Process):
 class AR1(Process):
     """First-order autoregression x_t = phi x_{t-1} + e_t, e_t i.i.d. N(0, sigma2).
 
-    Stationary (|phi| < 1): x_1 is drawn from N(0, sigma2 / (1 - phi^2)) and
+    Stationary (``|phi| < 1``): x_1 is drawn from N(0, sigma2 / (1 - phi^2)) and
     the recursion x_t = phi x_{t-1} + e_t runs in a compiled kernel. The theoretical AV
     is Zhang's (2008) closed form, :func:`avar.models.theory.av_ar1`.
 
