@@ -104,7 +104,7 @@ def test_from_dataframe_takes_the_rate_from_a_time_index():
 
 def test_from_dataframe_errors():
     df = pd.DataFrame(simulated(200), columns=list(R_NAMES))
-    with pytest.raises(ValueError, match="pass freq"):
+    with pytest.raises(ValueError, match="pass rate"):
         IMU.from_dataframe(df)
     irregular = df.set_axis(pd.to_datetime(np.cumsum(np.r_[0, np.ones(198), 2]) * 1e9))
     with pytest.raises(ValueError, match="irregular"):
@@ -171,12 +171,14 @@ def test_one_dimensional_data():
 
 @pytest.mark.parametrize("freq", [0, -1.0, np.nan, np.inf])
 def test_bad_freq(freq):
-    with pytest.raises(ValueError, match="freq must be a finite number > 0"):
+    with pytest.raises(ValueError, match="rate must be a finite number > 0"):
         IMU(simulated(100, 2), freq, gyro=0, accel=1)
+    with pytest.raises(ValueError, match="freq must be a finite number > 0"):  # the spelling given is named
+        IMU(simulated(100, 2), freq=freq, gyro=0, accel=1)
 
 
 def test_freq_type():
-    with pytest.raises(TypeError, match="freq"):
+    with pytest.raises(TypeError, match="rate"):
         IMU(simulated(100, 2), "100", gyro=0, accel=1)
 
 

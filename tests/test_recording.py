@@ -10,7 +10,7 @@ from avar.recording import Recording
 
 def test_columns_are_read_only_copies():
     source = np.arange(10.0)
-    rec = Recording({"gx": source, "n": np.arange(10)}, freq=50.0, rate_source="given")
+    rec = Recording({"gx": source, "n": np.arange(10)}, rate=50.0, rate_source="given")
     source[0] = 99.0
     assert rec["gx"][0] == 0.0  # a copy: the caller's array stays the caller's
     with pytest.raises(ValueError):
@@ -23,7 +23,7 @@ def test_columns_are_read_only_copies():
 
 
 def test_notes_say_where_the_rate_came_from():
-    timed = Recording({"x": np.zeros(8)}, freq=300.0, rate_source="time column 'time'", time_column="time",
+    timed = Recording({"x": np.zeros(8)}, rate=300.0, rate_source="time column 'time'", time_column="time",
                       jitter=3.3e-4, gap_rows=[5], gap_steps=[0.25], gaps_ignored=True, source="log.csv")
     assert timed.rate_note() == (
         "at 300 Hz from time column 'time' (jitter 0.33 ms rms); 1 gap(s) ignored: samples treated as "
@@ -39,6 +39,6 @@ def test_notes_say_where_the_rate_came_from():
 )
 def test_bad_columns(columns, message):
     with pytest.raises(ValueError, match=message):
-        Recording(columns, freq=1.0, rate_source="given")
+        Recording(columns, rate=1.0, rate_source="given")
     with pytest.raises(TypeError, match="numeric"):
-        Recording({"a": np.array(["x"] * 4)}, freq=1.0, rate_source="given")
+        Recording({"a": np.array(["x"] * 4)}, rate=1.0, rate_source="given")

@@ -274,7 +274,7 @@ def _rate_from_seconds(seconds: np.ndarray, what: str) -> float:
     if gaps.size:
         origin = seconds[0]
         message = describe_gaps(gaps, steps, median, lambda i: seconds[i] - origin)
-        raise ValueError(f"{what} has a time index with {message}; fill or cut them, or pass freq explicitly")
+        raise ValueError(f"{what} has a time index with {message}; fill or cut them, or pass the sampling rate explicitly")
     return rate
 
 
@@ -301,7 +301,7 @@ def rate_from_index(index: Any, what: str) -> float | None:
         raise ValueError(f"{what} has a time index that does not increase strictly; sort it or drop duplicate times")
     if np.any(steps != steps[0]):
         raise ValueError(f"{what} has an irregular time index (steps from {steps.min() * count} to "
-                         f"{steps.max() * count} {unit}); resample it to a regular grid or pass freq explicitly")
+                         f"{steps.max() * count} {unit}); resample it to a regular grid or pass the sampling rate explicitly")
     return 1.0 / (float(steps[0]) * (np.timedelta64(count, unit) / np.timedelta64(1, "s")))
 
 
@@ -316,15 +316,15 @@ def native_values(array: np.ndarray) -> np.ndarray | None:
     return None
 
 
-def as_series(x: Any, freq: Any, native: bool = False) -> tuple[np.ndarray, float]:
-    """Validate a 1-D series and its rate; return float64 values and freq.
+def as_series(x: Any, freq: Any, native: bool = False, rate_name: str = "freq") -> tuple[np.ndarray, float]:
+    """Validate a 1-D series and its rate; return float64 values and the rate (Hz).
 
     Integers spanning 2**53 or more are returned as integers (see :func:`as_float64`).
     ``native=True`` (for kernels that read any real dtype in place) returns integer, boolean and
     float32 arrays as they are, never copied to float64 (see :func:`native_values`).
 
     ``freq=None`` means the rate of a pandas time index when there is one,
-    otherwise 1 Hz.
+    otherwise 1 Hz. ``rate_name``: the parameter's name in messages (``"rate"`` or ``"freq"``).
     """
     what, index_rate = "x", None
     pd = sys.modules.get("pandas")  # not loaded: x cannot be a pandas object, and stays light
@@ -347,7 +347,7 @@ def as_series(x: Any, freq: Any, native: bool = False) -> tuple[np.ndarray, floa
     if freq is None:
         rate = index_rate if index_rate is not None else 1.0
     else:
-        rate = check_freq(freq)
+        rate = check_freq(freq, rate_name)
     return values, rate
 
 

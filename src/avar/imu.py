@@ -24,12 +24,12 @@ from avar._validation import (
     EXACT_INTEGER_LIMIT,
     as_array,
     check_finite,
-    check_freq,
     check_length,
     check_numeric_dtype,
     integer_range,
     rate_from_index,
 )
+from avar._vocabulary import check_rate, renamed
 
 GYROSCOPE = "Gyroscope"
 ACCELEROMETER = "Accelerometer"
@@ -150,9 +150,12 @@ class IMU:
         Samples (rows) of every channel (columns), any real dtype; stored as a
         read-only float64 copy (integers beyond 2**53 keep their integer dtype). A DataFrame keeps its column names as channel
         names.
-    freq : float
-        Sampling frequency in Hz (> 0). See :meth:`from_dataframe` to take it
+    rate : float
+        Sampling rate in Hz (> 0). See :meth:`from_dataframe` to take it
         from a regular time index.
+    freq : float
+        R's name of ``rate`` (keyword only), kept so that R code ports line by line;
+        give one of them.
     gyro, accel : str, int or list of them, optional
         The gyroscope and accelerometer columns, by name or 0-based index.
         Every column must be in exactly one of them. When both are omitted,
@@ -170,8 +173,10 @@ class IMU:
     data : ndarray, shape (N, C)
         Read-only float64 samples (column-major, each channel contiguous); int64
         or uint64 for integers beyond 2**53, which float64 cannot hold exactly.
-    freq : float
-        Sampling frequency in Hz.
+    rate : float
+        Sampling rate in Hz; ``freq`` is the same value under R's name.
+    n_samples : int
+        Samples per channel (``n`` is the same).
     channels : tuple of str
         Channel names: the DataFrame column names, or for an array
         ``"Gyro. X"``, ``"Accel. Y"``, ... as in the R data sets.
@@ -191,13 +196,13 @@ class IMU:
     ValueError
         Data that are not 2-D, fewer than 4 samples, a NaN or infinity (the
         message names the channel), duplicate column names, a column that is
-        neither gyro nor accel or that is both, an unknown column, freq <= 0.
+        neither gyro nor accel or that is both, an unknown column, rate <= 0.
 
     Examples
     --------
     >>> import numpy as np
     >>> x = np.random.default_rng(1).standard_normal((1000, 6))
-    >>> imu = IMU(x, freq=100, gyro=[0, 1, 2], accel=[3, 4, 5], name="demo")
+    >>> imu = IMU(x, rate=100, gyro=[0, 1, 2], accel=[3, 4, 5], name="demo")
     >>> imu.channels
     ('Gyro. X', 'Gyro. Y', 'Gyro. Z', 'Accel. X', 'Accel. Y', 'Accel. Z')
     >>> imu
@@ -217,13 +222,18 @@ class IMU:
     def __init__(
         self,
         data: Any,
-        freq: Any,
+        rate: Any = None,
         gyro: Any = None,
         accel: Any = None,
         axis: Any = None,
         name: str | None = None,
         units: Mapping[str, str] | None = None,
+        *,
+        freq: Any = None,
     ) -> None:
+        rate, rate_name = renamed("rate", rate, "freq", freq, deprecated=False)
+        if rate is None:
+            raise TypeError("IMU() needs the sampling rate: IMU(data, rate=HZ, ...) (R's freq= is accepted too)")
         pd = sys.modules.get("pandas")  # not loaded: data cannot be a pandas object
         if pd is not None and isinstance(data, pd.DataFrame):
             columns = tuple(str(c) for c in data.columns)
@@ -253,7 +263,7 @@ class IMU:
         if n_columns == 0:
             raise ValueError("IMU data has no channels (0 columns)")
         check_length(n, "IMU data")
-        rate = check_freq(freq)
+        rate = check_rate(rate, rate_name)
 
         positional = columns is None
         names = columns if columns is not None else tuple(str(j) for j in range(n_columns))
@@ -302,17 +312,20 @@ class IMU:
         set_field(self, "units", MappingProxyType(_check_units(units)))
 
     @classmethod
-    def from_dataframe(cls, df: pd.DataFrame, freq: Any = None, gyro: Any = None, accel: Any = None,
-                       axis: Any = None, name: str | None = None, units: Mapping[str, str] | None = None) -> IMU:
+    def from_dataframe(cls, df: pd.DataFrame, rate: Any = None, gyro: Any = None, accel: Any = None,
+                       axis: Any = None, name: str | None = None, units: Mapping[str, str] | None = None,
+                       *, freq: Any = None) -> IMU:
         """An IMU from a DataFrame, taking the rate from its time index.
 
         Parameters
         ----------
         df : pandas.DataFrame
-            One column per channel. With ``freq`` omitted, its index must be a
-            regular ``DatetimeIndex`` or ``TimedeltaIndex``: freq = 1 / step.
-        freq, gyro, accel, axis, name, units
+            One column per channel. With ``rate`` omitted, its index must be a
+            regular ``DatetimeIndex`` or ``TimedeltaIndex``: rate = 1 / step.
+        rate, gyro, accel, axis, name, units
             As for :class:`IMU`.
+        freq : float, optional
+            R's name of ``rate``, as for :class:`IMU`.
 
         Examples
         --------
@@ -328,17 +341,30 @@ class IMU:
 
         if not isinstance(df, pd.DataFrame):
             raise TypeError(f"df must be a pandas DataFrame, got {type(df).__name__}")
-        if freq is None:
-            freq = rate_from_index(df.index, "df")
-            if freq is None:
+        rate, rate_name = renamed("rate", rate, "freq", freq, deprecated=False)
+        if rate is None:
+            rate = rate_from_index(df.index, "df")
+            if rate is None:
                 raise ValueError(
-                    "df has no regular DatetimeIndex or TimedeltaIndex to take the rate from; pass freq (Hz)"
+                    "df has no regular DatetimeIndex or TimedeltaIndex to take the rate from; pass rate (Hz)"
                 )
-        return cls(df, freq, gyro=gyro, accel=accel, axis=axis, name=name, units=units)
+        elif rate_name == "freq":
+            return cls(df, gyro=gyro, accel=accel, axis=axis, name=name, units=units, freq=rate)
+        return cls(df, rate, gyro=gyro, accel=accel, axis=axis, name=name, units=units)
+
+    @property
+    def rate(self) -> float:
+        """Sampling rate in Hz (``freq`` under R's name)."""
+        return self.freq
+
+    @property
+    def n_samples(self) -> int:
+        """Samples per channel."""
+        return self.data.shape[0]
 
     @property
     def n(self) -> int:
-        """Samples per channel."""
+        """Samples per channel (the same as :attr:`n_samples`)."""
         return self.data.shape[0]
 
     def __len__(self) -> int:
@@ -354,7 +380,7 @@ class IMU:
         """The samples as a DataFrame with the channel names, indexed by time in seconds."""
         import pandas as pd
 
-        index = pd.Index(np.arange(self.n) / self.freq, name="Time")
+        index = pd.Index(np.arange(self.n) / self.rate, name="Time")
         return pd.DataFrame(np.array(self.data), index=index, columns=list(self.channels))
 
     def describe(self) -> str:

@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from avar._frozen import frozen_mapping
+from avar._vocabulary import check_rate, renamed
 
 
 def _read_only(values: Any) -> np.ndarray:
@@ -37,9 +38,12 @@ def _duration(seconds: float) -> str:
     raise AssertionError  # pragma: no cover
 
 
-@dataclass(frozen=True, eq=False)  # arrays: identity, as for any container of arrays
+@dataclass(frozen=True, eq=False, init=False)  # arrays: identity, as for any container of arrays
 class Recording:
     """Named series sampled together, with their rate and where it came from.
+
+    :func:`avar.read` builds it; ``Recording(columns, rate=..., rate_source=...)`` with the
+    fields below builds one by hand.
 
     Attributes
     ----------
@@ -47,12 +51,12 @@ class Recording:
         The data columns in file order, read-only 1-D arrays of one length: float64, or
         int64 for columns of integers (kept exact; :func:`avar.avar` centres them
         exactly). Time columns are never among them.
-    freq : float
+    rate : float
         Sampling rate (Hz): from the time column, given by the caller, or 1.0 when
-        there is neither (then ``rate_source`` says so).
+        there is neither (then ``rate_source`` says so). ``freq`` is the same value.
     rate_source : str
-        Where ``freq`` came from, e.g. ``"time column 'time'"``, ``"given"`` or
-        ``"none (no time column): 1 Hz, sample numbers as time"``.
+        Where ``rate`` came from, e.g. ``"time column 'time'"``, ``"given"`` (the
+        default) or ``"none (no time column): 1 Hz, sample numbers as time"``.
     time_column : str or None
         The column that timed the samples.
     jitter : float or None
@@ -69,22 +73,36 @@ class Recording:
     Examples
     --------
     >>> import numpy as np
-    >>> rec = Recording({"gx": np.arange(6.0)}, freq=100.0, rate_source="given")
-    >>> rec.names, rec.n, rec["gx"][:3]
+    >>> rec = Recording({"gx": np.arange(6.0)}, rate=100.0, rate_source="given")
+    >>> rec.names, rec.n_samples, rec["gx"][:3]
     (('gx',), 6, array([0., 1., 2.]))
     >>> rec.rate_note()
     'at 100 Hz (given)'
     """
 
     columns: Mapping[str, np.ndarray]
-    freq: float
-    rate_source: str
+    rate: float
+    rate_source: str = "given"
     time_column: str | None = None
     jitter: float | None = None
     gap_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     gap_steps: np.ndarray = field(default_factory=lambda: np.zeros(0))
     gaps_ignored: bool = False
     source: str = ""
+
+    def __init__(self, columns: Mapping[str, Any], rate: float | None = None, rate_source: str = "given",
+                 time_column: str | None = None, jitter: float | None = None, gap_rows: Any = (),
+                 gap_steps: Any = (), gaps_ignored: bool = False, source: str = "", *,
+                 freq: float | None = None) -> None:
+        rate, rate_name = renamed("rate", rate, "freq", freq, deprecated=True)
+        if rate is None:
+            raise TypeError("a Recording needs its sampling rate: Recording(columns, rate=HZ)")
+        values = {"columns": columns, "rate": check_rate(rate, rate_name), "rate_source": rate_source, "time_column": time_column,
+                  "jitter": jitter, "gap_rows": gap_rows, "gap_steps": gap_steps, "gaps_ignored": gaps_ignored,
+                  "source": source}
+        for name, value in values.items():
+            object.__setattr__(self, name, value)
+        self.__post_init__()
 
     def __post_init__(self) -> None:
         if not isinstance(self.columns, Mapping) or not self.columns:
@@ -104,9 +122,19 @@ class Recording:
         return tuple(self.columns)
 
     @property
-    def n(self) -> int:
+    def freq(self) -> float:
+        """The sampling rate in Hz: :attr:`rate` under R's name."""
+        return self.rate
+
+    @property
+    def n_samples(self) -> int:
         """Number of samples."""
         return int(next(iter(self.columns.values())).shape[0])
+
+    @property
+    def n(self) -> int:
+        """Number of samples (the same as :attr:`n_samples`)."""
+        return self.n_samples
 
     def __len__(self) -> int:
         return self.n
@@ -118,13 +146,13 @@ class Recording:
             raise KeyError(f"no column {name!r}; the recording has {list(self.columns)}") from None
 
     def to_dataframe(self) -> pd.DataFrame:
-        """The columns as a DataFrame indexed by time from the first sample (s, at ``freq``)."""
-        index = pd.Index(np.arange(self.n) / self.freq, name="Time")
+        """The columns as a DataFrame indexed by time from the first sample (s, at ``rate``)."""
+        index = pd.Index(np.arange(self.n) / self.rate, name="Time")
         return pd.DataFrame(dict(self.columns), index=index)
 
     def rate_note(self) -> str:
         """``'at 300 Hz from time column 'time' (jitter 0.33 ms rms)'``, and the gaps if any."""
-        note = f"at {self.freq:.6g} Hz"
+        note = f"at {self.rate:.6g} Hz"
         note += f" from {self.rate_source}" if self.time_column is not None else f" ({self.rate_source})"
         if self.jitter is not None:
             note += f" (jitter {_duration(self.jitter)} rms)" if self.jitter >= 1e-9 else " (jitter < 1 ns rms)"

@@ -179,7 +179,8 @@ def test_freq_overrides_the_rate_but_time_stays_out_of_the_data(series_file):
     [
         (["--column", "gx", "--wn", "7:1"], "invalid scale range '7:1'"),
         (["--column", "gx", "--wn", "1:5", "--per-axis"], "--per-axis applies to IMU fits only"),
-        (["--gyro", "gx", "--wn", "1:5", "--units", "deg/s"], "for an IMU give gyro=UNIT"),
+        (["--column", "gx", "--wn", "1:5", "--gyro-units", "deg/s", "--accel-units", "g"],
+         "give --gyro-units or --accel-units, not both"),
         (["--column", "gx", "--wn", "1:5", "--wn-gyro", "1:3"], "--wn-gyro apply to IMU fits only"),
     ],
 )

@@ -1,4 +1,4 @@
-"""``avar fit`` options for IMU fits: --ci, --per-axis, --deviation, --units (real files, subprocesses)."""
+"""``avar fit`` options for IMU fits: --ci, --per-axis, --deviation, --gyro-units/--accel-units (real files, subprocesses)."""
 
 from __future__ import annotations
 
@@ -32,8 +32,8 @@ def test_imu_bootstrap_per_axis_with_units_and_deviation_plot(imu_file, tmp_path
     path, data = imu_file
     png, out = tmp_path / "fit.png", tmp_path / "fit.csv"
     result = run(str(path), "--gyro", "gx", "--gyro", "gy", "--accel", "ax", "--accel", "ay", "--wn", "1:5",
-                 "--ci", "--B", "20", "--seed", "3", "--per-axis", "--deviation", "--units", "gyro=deg/s",
-                 "--units", "accel=g", "--plot", str(png), "--output", str(out))
+                 "--ci", "--B", "20", "--seed", "3", "--per-axis", "--deviation", "--gyro-units", "deg/s",
+                 "--accel-units", "g", "--plot", str(png), "--output", str(out))
     assert result.returncode == 0, result.stderr
     assert "Bootstrap (B = 20)" in result.stdout and "Lower" in result.stdout
     labels = out.read_text()

@@ -85,7 +85,7 @@ def test_errors_are_one_line(tmp_path):
     path = tmp_path / "x.csv"
     pd.DataFrame({"gx": np.random.default_rng(1).standard_normal(1000)}).to_csv(path, index=False)
     result = run(str(path))
-    assert result.returncode == 1 and "--freq" in result.stderr and "Traceback" not in result.stderr
+    assert result.returncode == 1 and "--rate" in result.stderr and "Traceback" not in result.stderr
     result = run(str(path), "--freq", "100", "--gyro-units", "rpm")
     assert result.returncode == 2
     result = run(str(tmp_path / "missing.csv"), "--freq", "100")

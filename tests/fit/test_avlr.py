@@ -210,7 +210,7 @@ def test_bootstrap_intervals_use_the_normal_quantile():
         half_width = (table["Upper"] - table["Lower"]) / (2 * table["SD"])
         np.testing.assert_allclose(half_width, norm.ppf(1 - alpha / 2), rtol=1e-12)
         np.testing.assert_allclose((table["Upper"] + table["Lower"]) / 2, table["Estimate"], rtol=1e-12)
-        assert fit.alpha == alpha and fit.replicates == 50
+        assert fit.confidence == pytest.approx(1 - alpha) and fit.replicates == 50
 
 
 def test_bootstrap_is_bias_corrected_seeded_and_in_data_units():

@@ -143,7 +143,7 @@ def test_bootstrap_intervals():
     assert 0.005 < table.loc["WN.sigma2", "SE"] < 0.03
     again = gmwm(x, "WN + RW", ci=True, B=30, seed=3)
     pd.testing.assert_frame_equal(again.ci, fit.ci)
-    assert fit.alpha == 0.05 and fit.replicates == 30
+    assert fit.confidence == 0.95 and fit.replicates == 30
 
 
 def test_result_is_immutable_and_printable():
@@ -186,7 +186,7 @@ def test_imu_is_fitted_channel_by_channel():
         ({"model": "WN", "weights": "optimal"}, ValueError, "weights must be one of"),
         ({"model": "WN", "ci": 1}, TypeError, "ci must be True or False"),
         ({"model": "WN", "B": 1}, ValueError, "B must be"),
-        ({"model": "WN", "alpha": 1.5}, ValueError, r"alpha must be in \(0, 1\)"),
+        ({"model": "WN", "confidence": 1.5}, ValueError, r"confidence must be in \(0, 1\)"),
         ({"model": "WN", "model_gyro": "WN"}, ValueError, "IMU data only"),
     ],
 )
@@ -209,7 +209,7 @@ def test_a_one_column_recording_is_fitted_at_its_rate():
 
     x = (avar.WN(sigma2=1.0) + avar.RW(gamma2=1e-5)).simulate(2**15, seed=8)
     direct = avar.gmwm(avar.avar(x, freq=50.0, taus=2 ** np.arange(0, 15) / 50.0), "WN + RW")
-    recorded = avar.gmwm(avar.Recording({"gx": x}, freq=50.0, rate_source="given"), "WN + RW")
+    recorded = avar.gmwm(avar.Recording({"gx": x}, rate=50.0, rate_source="given"), "WN + RW")
     np.testing.assert_allclose(recorded.estimates, direct.estimates, rtol=1e-10)
     with pytest.raises(ValueError, match="Recording of 2 columns"):
-        avar.gmwm(avar.Recording({"a": x, "b": x}, freq=50.0, rate_source="given"), "WN + RW")
+        avar.gmwm(avar.Recording({"a": x, "b": x}, rate=50.0, rate_source="given"), "WN + RW")

@@ -79,7 +79,7 @@ def test_every_axis_is_named_in_a_comment_above_its_density(report, tmp_path):
 def test_topic_rate_and_overrides(report, recording, tmp_path):
     fields = report.kalibr(rostopic="/other", update_rate=200, gyroscope_random_walk=1e-5)
     assert (fields["rostopic"], fields["update_rate"], fields["gyroscope_random_walk"]) == ("/other", 200.0, 1e-5)
-    plain = avar.noise_report(recording.columns[["gyro_x"]], gyro_units="deg/s", freq=FREQ)
+    plain = avar.noise_report(recording.columns[["gyro_x"]], gyro_units="deg/s", rate=FREQ)
     assert plain.kalibr()["rostopic"] == "/imu0"  # Kalibr's example topic when not from a bag
     assert list(plain.kalibr()) == ["gyroscope_noise_density", "gyroscope_random_walk", "rostopic", "update_rate"]
     with pytest.raises(TypeError, match="unknown Kalibr field"):
@@ -99,7 +99,7 @@ def test_existing_file_is_refused_and_nothing_half_written(report, tmp_path):
 
 def test_an_unresolved_random_walk_gives_its_bound_with_a_comment(tmp_path):
     x = WN(sigma2=1e-4).simulate(50_000, seed=1)
-    rep = avar.noise_report(x, gyro_units="rad/s", freq=100.0)
+    rep = avar.noise_report(x, gyro_units="rad/s", rate=100.0)
     row = rep.table.set_index("Process").loc["RW"]
     assert row["Status"] == "bound" and row["Value"] is pd.NA
     path = rep.to_kalibr(tmp_path / "imu.yaml")
@@ -111,4 +111,4 @@ def test_an_unresolved_random_walk_gives_its_bound_with_a_comment(tmp_path):
     assert 0 < fields["gyroscope_random_walk"] < 1e-3
     assert rep.kalibr(gyroscope_random_walk=1e-6)["gyroscope_random_walk"] == 1e-6
     with pytest.raises(ValueError, match="no gyroscope or accelerometer"):
-        avar.noise_report(x, freq=100.0).kalibr()
+        avar.noise_report(x, rate=100.0).kalibr()

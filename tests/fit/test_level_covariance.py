@@ -148,7 +148,7 @@ def test_non_overlapping_estimates_get_wider_intervals_for_the_random_walk():
     x = rng.standard_normal(2**18) + np.cumsum(1e-3 * rng.standard_normal(2**18))
     widths = {}
     for type in ("mo", "to"):
-        table = avar.noise_report(x, gyro_units="rad/s", freq=100.0, type=type).table
+        table = avar.noise_report(x, gyro_units="rad/s", rate=100.0, type=type).table
         row = table[table["Process"] == "RW"].iloc[0]
         widths[type] = float(row["Upper"]) - float(row["Lower"])
     assert widths["to"] > 1.2 * widths["mo"]

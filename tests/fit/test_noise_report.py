@@ -33,7 +33,7 @@ def gyro():
 
 @pytest.fixture(scope="module")
 def report(gyro):
-    return avar.noise_report(gyro, gyro_units="deg/s", freq=FREQ)
+    return avar.noise_report(gyro, gyro_units="deg/s", rate=FREQ)
 
 
 def test_terms_match_the_simulated_truth(report):
@@ -58,8 +58,8 @@ def test_customary_units_follow_ieee_952(report):
 
 
 def test_units_of_the_data_only_rescale(gyro, report):
-    in_rad = avar.noise_report(gyro * DEG, gyro_units="rad/s", freq=FREQ)
-    in_deg_h = avar.noise_report(gyro * 3600, gyro_units="deg/h", freq=FREQ)
+    in_rad = avar.noise_report(gyro * DEG, gyro_units="rad/s", rate=FREQ)
+    in_deg_h = avar.noise_report(gyro * 3600, gyro_units="deg/h", rate=FREQ)
     for other in (in_rad, in_deg_h):
         for process in ("WN", "FN", "RW"):
             assert other.value("x", process) == pytest.approx(report.value("x", process), rel=1e-9)
@@ -78,7 +78,7 @@ def test_absent_processes_are_absent_never_nan(report):
 
 def test_white_noise_alone_reports_only_white_noise():
     x = WN(sigma2=1e-4).simulate(100_000, seed=2)
-    rep = avar.noise_report(x, accel_units="m/s^2", freq=50.0)
+    rep = avar.noise_report(x, accel_units="m/s^2", rate=50.0)
     statuses = dict(zip(rep.table["Process"], rep.table["Status"]))
     # the terms an engineer needs are bounded when the data do not show them; the others absent
     assert statuses == {"QN": "absent", "WN": "present", "FN": "bound", "RW": "bound", "DR": "absent", "MIN": "measured"}
@@ -91,7 +91,7 @@ def test_white_noise_alone_reports_only_white_noise():
 
 def test_quantization_is_found():
     x = (QN(q2=0.05) + WN(sigma2=0.01)).simulate(200_000, seed=3)
-    rep = avar.noise_report(x, freq=10.0)
+    rep = avar.noise_report(x, rate=10.0)
     # QN.from_continuous: q2 = Q^2 f^2
     assert rep.value("x", "QN") == pytest.approx(math.sqrt(0.05) / 10.0, rel=0.05)
     assert rep.table.set_index("Process").loc["QN", "Unit"] == "u s"  # unknown sensor: data units
@@ -99,12 +99,12 @@ def test_quantization_is_found():
 
 def test_accelerometer_units(gyro):
     # the same numbers read as an accelerometer in g: SI = g0 times, ug = B[g] * 1e6
-    rep = avar.noise_report(gyro, accel_units="g", freq=FREQ)
+    rep = avar.noise_report(gyro, accel_units="g", rate=FREQ)
     b_g = math.sqrt([c.scale for c in rep.fits["x"].components if c.kind == "FN"][0])
     assert rep.value("x", "FN") == pytest.approx(b_g * 9.80665, rel=1e-12)
     assert rep.value("x", "FN", customary=True) == pytest.approx(b_g * 1e6, rel=1e-12)
     assert rep.value("x", "WN", customary=True) == pytest.approx(rep.value("x", "WN") * 60, rel=1e-12)
-    in_mg = avar.noise_report(gyro * 1000, accel_units="mg", freq=FREQ)
+    in_mg = avar.noise_report(gyro * 1000, accel_units="mg", rate=FREQ)
     assert in_mg.value("x", "FN") == pytest.approx(rep.value("x", "FN"), rel=1e-9)
 
 
@@ -142,7 +142,7 @@ def test_every_input_kind_gives_the_same_terms(gyro, report):
     reports = [
         avar.noise_report(imu),
         avar.noise_report(avar.avar(imu, taus=2.0 ** np.arange(18) / FREQ)),
-        avar.noise_report(frame, gyro_units="deg/s", freq=FREQ),
+        avar.noise_report(frame, gyro_units="deg/s", rate=FREQ),
         avar.noise_report(recording, gyro_units="deg/s"),
         avar.noise_report(mapping, gyro_units="deg/s"),
         avar.noise_report(avar.avar(gyro, freq=FREQ, taus=2.0 ** np.arange(18) / FREQ), gyro_units="deg/s"),
@@ -162,11 +162,11 @@ def test_bad_arguments():
         avar.noise_report(x, gyro_units="rpm")
     with pytest.raises(ValueError, match="not both"):
         avar.noise_report(x, gyro_units="rad/s", accel_units="g")
-    with pytest.raises(ValueError, match="alpha"):
-        avar.noise_report(x, alpha=1.5)
+    with pytest.raises(ValueError, match="confidence"):
+        avar.noise_report(x, confidence=1.5)
     with pytest.raises(ValueError, match="at least 3"):
         avar.noise_report(x[:5])
     with pytest.raises(ValueError, match="gyro column"):
-        avar.noise_report(pd.DataFrame({"a": x}), gyro=["b"], freq=1.0)
+        avar.noise_report(pd.DataFrame({"a": x}), gyro=["b"], rate=1.0)
     with pytest.raises(KeyError, match="no term"):
         avar.noise_report(x).value("x", "XX")

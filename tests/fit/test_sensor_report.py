@@ -51,7 +51,7 @@ def test_white_flicker_and_random_walk_of_independent_code(seed):
     rng = np.random.default_rng(seed)
     x = truth["WN"] * math.sqrt(FREQ) * rng.standard_normal(n) + flicker(rng, n, truth["FN"], FREQ)
     x += np.cumsum(truth["RW"] / math.sqrt(FREQ) * rng.standard_normal(n))
-    report = avar.noise_report(x, gyro_units="rad/s", freq=FREQ)
+    report = avar.noise_report(x, gyro_units="rad/s", rate=FREQ)
     assert row(report, "WN")["Value"] == pytest.approx(truth["WN"], rel=0.01)
     assert row(report, "FN")["Value"] == pytest.approx(truth["FN"], rel=0.15)
     walk = row(report, "RW")
@@ -63,7 +63,7 @@ def test_a_gauss_markov_term_gives_its_correlation_time():
     n = int(1800 * FREQ)
     rng = np.random.default_rng(4)
     x = 1e-3 * math.sqrt(FREQ) * rng.standard_normal(n) + gauss_markov(rng, n, 3e-3, 2.0, FREQ)
-    report = avar.noise_report(x, gyro_units="rad/s", freq=FREQ)
+    report = avar.noise_report(x, gyro_units="rad/s", rate=FREQ)
     times = report.table[report.table["Process"].str.endswith(".T")]
     assert len(times) >= 1
     best = times.iloc[int(np.argmin(np.abs(np.log(times["Value"].astype(float) / 2.0))))]
@@ -77,7 +77,7 @@ def test_a_sinusoid_gives_its_frequency_and_amplitude():
     rng = np.random.default_rng(5)
     t = np.arange(n) / FREQ
     x = 0.01 * rng.standard_normal(n) + 0.02 * np.sin(2 * np.pi * 1.7 * t + 0.3)
-    report = avar.noise_report(x, accel_units="m/s^2", freq=FREQ)
+    report = avar.noise_report(x, accel_units="m/s^2", rate=FREQ)
     hertz = report.table[report.table["Process"].str.startswith("SIN") & report.table["Process"].str.endswith(".f")]
     amplitude = report.table[report.table["Term"].str.endswith("amplitude")]
     near = np.abs(hertz["Value"].astype(float) - 1.7) / 1.7
@@ -151,7 +151,7 @@ def test_wrong_units_are_warned_with_the_flag():
 
 def test_a_short_log_never_fits_more_terms_than_its_levels_support():
     x = (WN(sigma2=1.0) + AR1(phi=0.9, sigma2=0.1)).simulate(50, seed=2)
-    report = avar.noise_report(x, gyro_units="rad/s", freq=10.0)
+    report = avar.noise_report(x, gyro_units="rad/s", rate=10.0)
     fit = report.fits["x"]
     parameters = sum(1 if c.shape is None else 2 for c in fit.components)
     assert parameters <= len(report.avs["x"]) - 2
@@ -166,9 +166,9 @@ def test_spikes_are_warned_about_and_the_robust_report_gives_the_clean_terms():
     spiked = clean.copy()
     where = rng.choice(n, n // 20, replace=False)  # 5 % of the samples
     spiked[where] += 20 * sigma * rng.choice([-1.0, 1.0], where.size)
-    truth = avar.noise_report(clean, gyro_units="rad/s", freq=FREQ)
-    plain = avar.noise_report(spiked, gyro_units="rad/s", freq=FREQ)
-    robust = avar.noise_report(spiked, gyro_units="rad/s", freq=FREQ, robust=True)
+    truth = avar.noise_report(clean, gyro_units="rad/s", rate=FREQ)
+    plain = avar.noise_report(spiked, gyro_units="rad/s", rate=FREQ)
+    robust = avar.noise_report(spiked, gyro_units="rad/s", rate=FREQ, robust=True)
     assert not truth.warnings
     assert any("outliers" in w and "--robust" in w for w in plain.warnings)
     assert plain.value("x", "WN") > 3 * truth.value("x", "WN")  # the spikes swamp the white noise
@@ -180,7 +180,7 @@ def test_spikes_are_warned_about_and_the_robust_report_gives_the_clean_terms():
 def test_a_time_indexed_series_gives_its_rate_to_the_plain_and_the_robust_report():
     x = WN(sigma2=1e-4).simulate(40_000, seed=3)
     series = pd.Series(x, index=pd.date_range("2026-01-01", periods=x.size, freq="10ms"))
-    plain = avar.noise_report(x, gyro_units="rad/s", freq=100.0)
+    plain = avar.noise_report(x, gyro_units="rad/s", rate=100.0)
     for report in (avar.noise_report(series, gyro_units="rad/s"),
                    avar.noise_report(series, gyro_units="rad/s", robust=True)):
         assert report.freq == 100.0

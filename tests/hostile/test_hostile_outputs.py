@@ -243,7 +243,7 @@ def test_kalibr_with_a_failing_plot_writes_nothing(tmp_path, capsys, monkeypatch
 def _report(source=None):
     terms = pd.DataFrame({"Sensor": ["Gyroscope"] * 2, "Process": ["WN", "RW"], "Status": ["present"] * 2,
                           "Value": [1e-3, 2e-5]})
-    return SimpleNamespace(terms=terms, sensor_types=("Gyroscope",), topic=None, freq=200.0, source=source)
+    return SimpleNamespace(terms=terms, sensor_types=("Gyroscope",), topic=None, rate=200.0, source=source)
 
 
 def test_write_kalibr_mode_follows_the_umask(tmp_path):

@@ -189,7 +189,7 @@ def test_time_must_increase(tmp_path):
 
 
 def test_freq_overrides_the_time_column_which_stays_out(tmp_path):
-    rec = read(write(tmp_path, "f.csv", "time,v\n0,1\n1,2\n2,3\n3,4\n"), freq=25)
+    rec = read(write(tmp_path, "f.csv", "time,v\n0,1\n1,2\n2,3\n3,4\n"), rate=25)
     assert rec.freq == 25.0 and rec.names == ("v",) and rec.rate_source == "given"
 
 
@@ -242,7 +242,7 @@ def test_npz_archives_of_named_columns_or_an_array_and_its_names(tmp_path):
     names = np.array(["Gyro. X", "Gyro. Y", "Gyro. Z", "Accel. X", "Accel. Y", "Accel. Z"])
     data = RNG.standard_normal((400, 6))
     np.savez_compressed(tmp_path / "named.npz", data=data, columns=names)  # as the ADIS16405 logs come
-    rec = read(tmp_path / "named.npz", freq=100.0)
+    rec = read(tmp_path / "named.npz", rate=100.0)
     assert rec.names == tuple(names) and rec.freq == 100.0
     np.testing.assert_array_equal(rec["Accel. Z"], data[:, 5])
     np.savez(tmp_path / "timed.npz", time=np.arange(400) / 50.0, data=data, columns=names)  # a time beside

@@ -136,7 +136,7 @@ def test_html_refuses_an_existing_file_without_force(tmp_path):
 
 def test_warnings_and_curves_are_rendered_when_the_report_has_them():
     x = avar.WN(sigma2=1e-4).simulate(3000, seed=2)
-    report = avar.noise_report(x, gyro_units="rad/s", freq=RATE)
+    report = avar.noise_report(x, gyro_units="rad/s", rate=RATE)
 
     class Extended:  # the report with the attributes being added beside this work
         def __getattr__(self, name):

@@ -8,11 +8,15 @@ import time
 
 import pandas as pd
 
-from avar._validation import short_repr
+from avar._validation import check_freq, short_repr
+from avar._vocabulary import REMOVED_IN, complement
+from avar.fit.report.noise_terms import ACCEL, GYRO, UNIT_SPELLINGS, check_unit
 from avar.io.read import InputFileError
 
-__all__ = ["FLOAT_FORMAT", "InputFileError", "Progress", "UsageError", "confidence_alpha", "display", "format_table",
-           "parse_scales", "printable", "replicates", "seed_number"]
+__all__ = ["FLOAT_FORMAT", "InputFileError", "Progress", "UsageError", "accel_unit", "add_confidence_arguments",
+           "add_rate_arguments", "add_unit_arguments", "confidence_alpha", "confidence_level", "display",
+           "format_table", "gyro_unit", "parse_scales", "printable", "replicates", "resolve_aliases", "seed_number",
+           "unit_label"]
 
 FLOAT_FORMAT = "{:.6g}".format
 
@@ -111,8 +115,112 @@ def format_table(frame: pd.DataFrame, index: bool = False) -> str:
     return frame.to_string(index=index, float_format=FLOAT_FORMAT)
 
 
+def confidence_level(text: str) -> float:
+    """``--confidence``: a probability strictly between 0 and 1 (0.95 for 95 % intervals)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"expected a confidence level, a number in (0, 1) such as 0.95, "
+                                         f"got {short_repr(text)}")
+    return value
+
+
+def _unit_type(kind: str, option: str):
+    def unit(text: str) -> str:
+        try:
+            return check_unit(text, kind, option)
+        except (TypeError, ValueError):
+            raise argparse.ArgumentTypeError(f"expected a {kind.lower()} unit: {', '.join(UNIT_SPELLINGS[kind])} "
+                                             f"(any case), got {short_repr(text)}") from None
+
+    unit.__name__ = option.strip("-").replace("-", "_")
+    unit.__doc__ = f"``{option}``: a {kind.lower()} data unit, in its canonical spelling."
+    return unit
+
+
+#: ``--gyro-units`` / ``--accel-units``: the unit spellings Python's ``gyro_units=`` / ``accel_units=`` take.
+gyro_unit = _unit_type(GYRO, "--gyro-units")
+accel_unit = _unit_type(ACCEL, "--accel-units")
+
+
+def unit_label(unit: str, deviation: bool) -> str:
+    """The y label of a figure of data in ``unit``: ``Allan deviation [deg/s]``, ``Allan variance [(g)^2]``."""
+    return f"Allan deviation [{unit}]" if deviation else f"Allan variance [({unit})^2]"
+
+
+def add_rate_arguments(parser: argparse.ArgumentParser, default: str) -> None:
+    """``--rate HZ`` and its hidden alias ``--freq`` (R's name)."""
+    parser.add_argument("--rate", type=float, metavar="HZ", default=None,
+                        help=f"sampling rate in Hz (default: {default})")
+    parser.add_argument("--freq", type=float, metavar="HZ", default=None, help=argparse.SUPPRESS)
+
+
+def add_confidence_arguments(parser: argparse.ArgumentParser, default: float, what: str,
+                             deprecated_alpha: bool = False, default_text: str | None = None) -> None:
+    """``--confidence P`` (a probability; ``default`` when not given) and, for the subcommands that had it,
+    the hidden deprecated ``--alpha`` (1 - P)."""
+    parser.add_argument("--confidence", type=confidence_level, metavar="P", default=None,
+                        help=f"confidence level of {what}, a probability in (0, 1) "
+                             f"(default {default_text or format(default, 'g')})")
+    parser.set_defaults(confidence_default=default)
+    if deprecated_alpha:
+        parser.add_argument("--alpha", type=confidence_alpha, default=None, help=argparse.SUPPRESS)
+
+
+def add_unit_arguments(parser: argparse.ArgumentParser, series: str) -> None:
+    """``--gyro-units`` and ``--accel-units``, the spellings of Python's ``gyro_units=`` and ``accel_units=``."""
+    parser.add_argument("--gyro-units", type=gyro_unit, metavar="UNIT",
+                        help=f"unit of the gyroscope data: {', '.join(UNIT_SPELLINGS[GYRO])} (default: rad/s, "
+                             f"{series})")
+    parser.add_argument("--accel-units", type=accel_unit, metavar="UNIT",
+                        help=f"unit of the accelerometer data: {', '.join(UNIT_SPELLINGS[ACCEL])} (default: m/s^2, "
+                             f"{series})")
+
+
+def resolve_aliases(args: argparse.Namespace) -> list[str]:
+    """Fold the aliases of the parsed options into their names; the notes to print on stderr.
+
+    ``--freq`` becomes ``--rate`` (``args.rate_option`` says which was typed; the value is
+    checked under that name), ``--alpha A`` (deprecated) becomes ``--confidence 1 - A``, and
+    ``--confidence`` takes its subcommand's default when neither is given. Both spellings
+    of one option: a UsageError naming both.
+    """
+    notes = []
+    if hasattr(args, "rate"):
+        freq = getattr(args, "freq", None)
+        args.rate_option = "--rate"
+        if freq is not None:
+            if args.rate is not None:
+                raise UsageError("give --rate or its alias --freq, not both")
+            args.rate, args.rate_option = freq, "--freq"
+        if args.rate is not None:
+            try:
+                args.rate = check_freq(args.rate, args.rate_option)
+            except ValueError as error:
+                raise UsageError(str(error)) from None
+    if hasattr(args, "freq"):
+        del args.freq
+    if hasattr(args, "confidence"):
+        alpha = getattr(args, "alpha", None)
+        if alpha is not None:
+            if args.confidence is not None:
+                raise UsageError("give --confidence or the deprecated --alpha (1 - confidence), not both")
+            args.confidence = complement(alpha)
+            if not args.confidence < 1.0:
+                raise UsageError(f"--alpha {alpha!r} is too small: 1 - alpha rounds to 1; give --confidence")
+            notes.append(f"--alpha is deprecated and will be removed in avar {REMOVED_IN}; "
+                         f"use --confidence {args.confidence:g} (confidence = 1 - alpha)")
+        if args.confidence is None:
+            args.confidence = args.confidence_default
+    if hasattr(args, "alpha"):
+        del args.alpha
+    return notes
+
+
 def confidence_alpha(text: str) -> float:
-    """``--alpha``: 1 - the confidence level, a number strictly between 0 and 1."""
+    """``--alpha`` (deprecated): 1 - the confidence level, a number strictly between 0 and 1."""
     try:
         value = float(text)
     except ValueError:

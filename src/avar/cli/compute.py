@@ -12,14 +12,23 @@ import sys
 import threading
 from contextlib import contextmanager
 
-from avar.cli.common import Progress, format_table, printable
+from avar.cli.common import (
+    Progress,
+    add_rate_arguments,
+    add_unit_arguments,
+    format_table,
+    printable,
+    unit_label,
+)
 from avar.cli.compute_many import (
     ReadOptions,
     add_cluster_arguments,
     allan_of,
+    check_bag_units,
     figure_of,
     load,
     run_many,
+    series_unit,
     summary_of,
 )
 from avar.cli.outputs import csv_text, plan_outputs, report
@@ -118,54 +127,73 @@ def run(args: argparse.Namespace) -> int:
     if len(args.file) > 1 or args.workers is not None or args.scheduler is not None:
         return run_many(args)
     args = argparse.Namespace(**{**vars(args), "file": args.file[0]})
+    check_bag_units([args.file], args)
+    unit = series_unit(args, bool(args.gyro or args.accel))
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
     progress = Progress()
     results = compute_from_args(args, progress)
     summary = summary_of(results)
-    written = plan.write(csv=lambda: csv_text(summary), figure=lambda: figure_of(results))
+    ylab = None if unit is None else unit_label(unit, deviation=False)
+    written = plan.write(csv=lambda: csv_text(summary), figure=lambda: figure_of(results, ylab))
     progress("done")
     report(written, format_table(summary))
     return 0
 
 
+#: What every subcommand reads.
+FILE_HELP = "CSV/TSV/text, .npy/.npz, Parquet, .mat, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros]); see docs/reading.md"
+#: One help text per shared option, so that an option says the same in every subcommand.
+TIME_UNIT_HELP = "unit of a numeric time column: s, ms, us or ns (default: from its name, e.g. t_ns, 'time [ms]'; else s)"
+GAPS_HELP = "time steps > 1.5 median steps: refuse (error, the default) or treat the samples as contiguous (ignore)"
+TAUS_HELP = "grid of averaging times tau (s): octave (m = 2, 4, 8, ...; the default), decade or all"
+OUTPUT_HELP = "write the table to this CSV file ('-': stdout; default: none, the table is printed)"
+PLOT_HELP = "write the figure to this file, format from its extension: png, pdf, svg, ... (default: none)"
+FORCE_HELP = "replace existing output files (default: refuse)"
+
+
+def add_reading_arguments(parser: argparse.ArgumentParser, rate_default: str = "from a time column, else 1 Hz") -> None:
+    """How a file is read: its rate, its time column and its gaps (every subcommand that reads a file)."""
+    add_rate_arguments(parser, rate_default)
+    parser.add_argument("--time-unit", choices=["s", "ms", "us", "ns"], default=None, help=TIME_UNIT_HELP)
+    parser.add_argument("--gaps", choices=["error", "ignore"], default="error", help=GAPS_HELP)
+
+
+def add_output_arguments(parser: argparse.ArgumentParser, table: str = OUTPUT_HELP) -> None:
+    parser.add_argument("--output", metavar="CSV", help=table)
+    parser.add_argument("--plot", metavar="PNG", help=PLOT_HELP)
+    parser.add_argument("--force", action="store_true", help=FORCE_HELP)
+
+
 def add_input_arguments(parser: argparse.ArgumentParser, many: bool = False) -> None:
     """The reading and output options; ``many``: one or more files (``avar compute``)."""
-    what = "CSV/TSV/text, .npy/.npz, Parquet, .mat, or a ROS bag (.bag, .db3, .mcap; needs allanvar[ros]); see docs/reading.md"
     if many:
         parser.add_argument("file", nargs="+",
-                            help=f"{what}; several files give one table with a File column")
+                            help=f"{FILE_HELP}; several files give one table with a File column")
     else:
-        parser.add_argument("file", help=what)
+        parser.add_argument("file", help=FILE_HELP)
     parser.add_argument(
         "--column", action="append", metavar="NAME", help="column to use (repeatable; default: all but time columns)"
     )
-    parser.add_argument("--freq", type=float, help="sampling rate in Hz (default: from a time column, else 1)")
-    parser.add_argument(
-        "--time-unit",
-        choices=["s", "ms", "us", "ns"],
-        default=None,
-        help="unit of a numeric time column (default: from its name, e.g. t_ns, 'time [ms]'; else s)",
-    )
-    parser.add_argument(
-        "--gaps",
-        choices=["error", "ignore"],
-        default="error",
-        help="time steps > 1.5 median steps: refuse (default) or treat the samples as contiguous",
-    )
-    parser.add_argument("--topic", metavar="TOPIC", help="sensor_msgs/Imu topic of a ROS bag (default: its only one)")
-    parser.add_argument("--type", choices=["mo", "to"], default="mo", help="maximal overlap (mo) or tau overlap (to)")
-    parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help="tau grid")
+    add_reading_arguments(parser)
+    parser.add_argument("--topic", metavar="TOPIC",
+                        help="sensor_msgs/Imu topic of a ROS bag (default: the bag's only Imu topic)")
+    parser.add_argument("--type", choices=["mo", "to"], default="mo",
+                        help="estimator: maximal overlap (mo, the default) or tau overlap (to)")
+    parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help=TAUS_HELP)
     parser.add_argument("--gyro", action="extend", nargs="+", metavar="NAME",
-                        help="gyroscope columns, e.g. --gyro gx gy gz (makes an IMU)")
+                        help="gyroscope columns, e.g. --gyro gx gy gz (makes an IMU; default: none)")
     parser.add_argument("--accel", action="extend", nargs="+", metavar="NAME",
-                        help="accelerometer columns, e.g. --accel ax ay az (makes an IMU)")
-    parser.add_argument("--output", metavar="CSV", help="write the table to this CSV file ('-': stdout)")
-    parser.add_argument("--plot", metavar="PNG", help="write the figure to this file (format from its extension)")
-    parser.add_argument("--force", action="store_true", help="replace existing --output / --plot files")
+                        help="accelerometer columns, e.g. --accel ax ay az (makes an IMU; default: none)")
+    add_unit_arguments(parser, "or a ROS bag's SI unit; for separate series give one, which labels the figure")
+    add_output_arguments(parser)
 
 
 def add_parser(commands) -> None:
-    compute = commands.add_parser("compute", help="Allan variance of the columns of one or more files")
+    compute = commands.add_parser(
+        "compute", help="Allan variance of the columns of one or more files",
+        description="The Allan variance of every column of one or more files (or of an IMU's channels): the table "
+                    "Scale, Time (s), AVar, ADev, Lower CI, Upper CI; a figure; many files at once, optionally on "
+                    "a dask cluster.")
     add_input_arguments(compute, many=True)
     add_cluster_arguments(compute)
     compute.set_defaults(handler=run)

@@ -27,11 +27,11 @@ from typing import Any
 
 import pandas as pd
 
-from avar.cli.common import InputFileError, Progress, UsageError, format_table, printable
+from avar.cli.common import InputFileError, Progress, UsageError, format_table, printable, unit_label
 from avar.cli.outputs import csv_text, plan_outputs, report
 
-__all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "compute_file", "compute_files",
-           "figure_of", "load", "run_many", "summary_of"]
+__all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "check_bag_units", "compute_file",
+           "compute_files", "figure_of", "load", "run_many", "series_unit", "summary_of"]
 
 #: The progress bar over the files: None shows it when stderr is a terminal; True/False force it.
 SHOW_PROGRESS: bool | None = None
@@ -65,10 +65,10 @@ def scheduler_address(text: str) -> str:
 def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workers", type=positive_int, metavar="N", default=None,
                         help="compute the files in parallel on a local dask cluster of N worker processes "
-                             "(needs allanvar[dask])")
+                             "(needs allanvar[dask]; default: one file after the other, in this process)")
     parser.add_argument("--scheduler", type=scheduler_address, metavar="ADDRESS", default=None,
                         help="compute the files on the dask.distributed scheduler at ADDRESS, "
-                             "e.g. tcp://10.0.0.5:8786 (needs allanvar[dask])")
+                             "e.g. tcp://10.0.0.5:8786 (needs allanvar[dask]; default: none)")
 
 
 # ----------------------------------------------------------------------------- one file, anywhere
@@ -77,7 +77,7 @@ class ReadOptions:
     """How to read a file and which Allan variance to compute: picklable, for the workers of a cluster."""
 
     column: tuple[str, ...] = ()
-    freq: float | None = None
+    rate: float | None = None
     time_unit: str | None = None
     gaps: str = "error"
     topic: str | None = None
@@ -85,6 +85,10 @@ class ReadOptions:
     accel: tuple[str, ...] = ()
     type: str = "mo"
     taus: str = "octave"
+    gyro_units: str | None = None
+    accel_units: str | None = None
+    #: How the rate was given on the command line (``--rate`` or its alias ``--freq``), for the notes.
+    rate_option: str = "--rate"
 
     @classmethod
     def from_args(cls, args: argparse.Namespace) -> ReadOptions:
@@ -93,8 +97,15 @@ class ReadOptions:
                 "--column cannot be combined with --gyro/--accel: --gyro and --accel name the IMU's columns "
                 "(use them alone, or --column alone for separate series)"
             )
-        return cls(tuple(args.column or ()), args.freq, args.time_unit, args.gaps, args.topic,
-                   tuple(args.gyro or ()), tuple(args.accel or ()), args.type, args.taus)
+        return cls(tuple(args.column or ()), args.rate, args.time_unit, args.gaps, args.topic,
+                   tuple(args.gyro or ()), tuple(args.accel or ()), args.type, args.taus,
+                   getattr(args, "gyro_units", None), getattr(args, "accel_units", None),
+                   getattr(args, "rate_option", "--rate"))
+
+    @property
+    def units(self) -> dict[str, str]:
+        """The data units given, keyed as :class:`avar.IMU` takes them (``gyro``, ``accel``)."""
+        return {key: unit for key, unit in (("gyro", self.gyro_units), ("accel", self.accel_units)) if unit}
 
 
 def load(path: str, options: ReadOptions, progress: bool | None = None) -> tuple[Any, list[str]]:
@@ -106,26 +117,55 @@ def load(path: str, options: ReadOptions, progress: bool | None = None) -> tuple
     data = read(
         path,
         columns=list(options.column) or imu_columns or None,
-        freq=options.freq,
+        rate=options.rate,
         time_unit=options.time_unit,
         gaps=options.gaps,
         topic=options.topic,
         progress=progress,
     )
-    if isinstance(data, IMU):  # a bag
+    if isinstance(data, IMU):  # a bag: SI units by definition (check_bag_units refuses others)
         return data, [f"{path}: {data.describe()}"]
-    note = data.describe().replace("(given)", "(--freq)")
-    if data.time_column is None and options.freq is None:
-        note += "; pass --freq for seconds"
+    note = data.describe().replace("(given)", f"({options.rate_option})")
+    if data.time_column is None and options.rate is None:
+        note += "; pass --rate for seconds"
     notes = [note]
     if data.gaps_ignored:
         notes.append(f"{path}: --gaps ignore: the samples are treated as contiguous across the gaps")
     if imu_columns:
         frame = pd.DataFrame(dict(data.columns), copy=False)
-        imu = IMU(frame, data.freq, gyro=list(options.gyro) or None, accel=list(options.accel) or None,
-                  name=Path(path).stem)
+        imu = IMU(frame, data.rate, gyro=list(options.gyro) or None, accel=list(options.accel) or None,
+                  name=Path(path).stem, units=options.units)
         return imu, notes
     return data, notes
+
+
+#: The units of a ROS bag's sensor_msgs/Imu, by definition.
+BAG_UNITS = (("--gyro-units", "gyro_units", "rad/s"), ("--accel-units", "accel_units", "m/s^2"))
+
+
+def check_bag_units(paths: Iterable[str], args: argparse.Namespace) -> None:
+    """A ROS bag holds SI units by definition: any other ``--gyro-units``/``--accel-units`` is a usage error."""
+    from avar.io.read import BAG_SUFFIXES
+
+    if not any(Path(p).suffix.lower() in BAG_SUFFIXES or Path(p).is_dir() for p in paths):
+        return
+    for option, dest, si in BAG_UNITS:
+        value = getattr(args, dest, None)
+        if value is not None and value != si:
+            raise UsageError(f"{option} {value}: ROS bags hold sensor_msgs/Imu in SI units ({si}) by definition; "
+                             f"drop {option}")
+
+
+def series_unit(args: argparse.Namespace, imu: bool) -> str | None:
+    """The unit of separate series (not an IMU): the one of ``--gyro-units``/``--accel-units`` given, which
+    labels the figure; both for one kind of series is a usage error."""
+    gyro, accel = getattr(args, "gyro_units", None), getattr(args, "accel_units", None)
+    if imu:
+        return None
+    if gyro is not None and accel is not None:
+        raise UsageError("separate series are one kind of sensor: give --gyro-units or --accel-units, not both "
+                         "(name an IMU's columns with --gyro/--accel to give both)")
+    return gyro or accel
 
 
 def allan_of(data: Any, type: str, taus: str, names: Iterable[str] | None = None):
@@ -136,7 +176,7 @@ def allan_of(data: Any, type: str, taus: str, names: Iterable[str] | None = None
     if isinstance(data, IMU):
         return avar(data, type=type, taus=taus)
     names = data.columns if names is None else names
-    return {name: avar(data.columns[name], type=type, freq=data.freq, taus=taus) for name in names}
+    return {name: avar(data.columns[name], type, data.rate, taus=taus) for name in names}
 
 
 def summary_of(results) -> pd.DataFrame:
@@ -149,13 +189,14 @@ def summary_of(results) -> pd.DataFrame:
     return results.summary().reset_index()
 
 
-def figure_of(results):
+def figure_of(results, ylab: str | None = None):
+    """The figure of a result; ``ylab`` labels the y axis of separate series (their unit)."""
     from avar.plotting.compare import plot_compare
 
     if isinstance(results, dict):
         if len(results) == 1:
-            return next(iter(results.values())).plot()
-        return plot_compare(list(results.values()), labels=list(results))
+            return next(iter(results.values())).plot(ylab=ylab)
+        return plot_compare(list(results.values()), labels=list(results), ylab=ylab)
     return results.plot()
 
 
@@ -248,7 +289,7 @@ def summary_of_files(labels: list[str], results: list[Any]) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
-def figure_of_files(labels: list[str], results: list[Any]):
+def figure_of_files(labels: list[str], results: list[Any], ylab: str | None = None):
     """Every series of every file on one comparison figure."""
     from avar.plotting.compare import plot_compare
 
@@ -258,7 +299,7 @@ def figure_of_files(labels: list[str], results: list[Any]):
         for name, av in channels.items():
             curves.append(av)
             names.append(label if len(channels) == 1 else f"{label}: {name}")
-    return plot_compare(curves, labels=names)
+    return plot_compare(curves, labels=names, ylab=ylab)
 
 
 def _check_files(paths: list[str]) -> None:
@@ -292,6 +333,9 @@ def run_many(args: argparse.Namespace) -> int:
     if on_cluster and importlib.util.find_spec("distributed") is None:
         raise UsageError(DASK_MISSING)
     paths = [str(path) for path in args.file]
+    check_bag_units(paths, args)
+    unit = series_unit(args, bool(args.gyro or args.accel))
+    ylab = None if unit is None else unit_label(unit, deviation=False)
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=paths, force=args.force)
     _check_files(paths)
     if args.workers is not None:
@@ -312,13 +356,13 @@ def run_many(args: argparse.Namespace) -> int:
         summary = summary_of(results[0])
 
         def figure():
-            return figure_of(results[0])
+            return figure_of(results[0], ylab)
     else:
         labels = file_labels(paths)
         summary = summary_of_files(labels, results)
 
         def figure():
-            return figure_of_files(labels, results)
+            return figure_of_files(labels, results, ylab)
     written = plan.write(csv=lambda: csv_text(summary), figure=figure)
     progress("done")
     report(written, format_table(summary))

@@ -28,8 +28,12 @@ def run(args: argparse.Namespace) -> int:
 
 
 def add_parser(commands) -> None:
-    data = commands.add_parser("datasets", help="list the IMU data sets, or summarize / plot one")
-    data.add_argument("name", nargs="?", help="data set name, e.g. navchip_av")
-    data.add_argument("--plot", metavar="PNG", help="write the figure to this file (format from its extension)")
-    data.add_argument("--force", action="store_true", help="replace an existing --plot file")
+    data = commands.add_parser(
+        "datasets", help="list the IMU data sets, or summarize / plot one",
+        description="The R package's IMU Allan variance data sets, shipped inside the package: list them, or "
+                    "summarize and plot one.")
+    data.add_argument("name", nargs="?", help="data set name, e.g. navchip_av (default: list them all)")
+    data.add_argument("--plot", metavar="PNG",
+                      help="write the figure to this file, format from its extension: png, pdf, svg, ... (default: none)")
+    data.add_argument("--force", action="store_true", help="replace existing output files (default: refuse)")
     data.set_defaults(handler=run)

@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     force = args.force or (figure.is_file() and is_own_figure(figure))
     plan = plan_outputs(figure=str(figure), force=force, figure_option="--out")
     x = simulate_demo_series()
-    result = avar(x, freq=DEMO_FREQ)
+    result = avar(x, "mo", DEMO_FREQ)
     fit = avlr(result, **DEMO_SCALES)
     from avar import __version__
 
@@ -90,7 +90,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def add_parser(commands) -> None:
-    demo = commands.add_parser("demo", help="simulate a sensor, compute and fit its Allan variance, plot it")
+    demo = commands.add_parser(
+        "demo", help="simulate a sensor, compute and fit its Allan variance, plot it",
+        description=f"Simulate {DEMO_N} samples of white noise plus a random walk at {DEMO_FREQ:g} Hz, compute "
+                    "their Allan variance, fit it by AVLR and write the figure avar_demo.png.")
     demo.add_argument("--out", default=".", metavar="DIR", help="directory for avar_demo.png (default: .)")
-    demo.add_argument("--force", action="store_true", help="replace an existing avar_demo.png that an earlier avar demo did not write")
+    demo.add_argument("--force", action="store_true",
+                      help="replace an existing avar_demo.png that an earlier avar demo did not write (default: refuse)")
     demo.set_defaults(handler=run)

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from avar.cli.common import Progress, UsageError
+from avar.cli.common import Progress, UsageError, add_confidence_arguments
+from avar.cli.compute import add_output_arguments, add_reading_arguments
 from avar.cli.outputs import plan_outputs, report
 from avar.stability.shared.confidence import DEFAULT_CONFIDENCE
 from avar.stability.shared.registry import DEVIATION_STATISTICS
@@ -33,7 +34,7 @@ def statistic_function(name: str):
 
 def table_of(result) -> pd.DataFrame:
     """One row per level: AF (m), Tau, # (terms), Alpha, Min Sigma, Sigma, Max Sigma."""
-    return pd.DataFrame({"AF": result.averaging_factors, "Tau": result.taus, "#": result.n, "Alpha": result.alpha,
+    return pd.DataFrame({"AF": result.averaging_factors, "Tau": result.taus, "#": result.n_terms, "Alpha": result.alpha,
                          "Min Sigma": result.lci, "Sigma": result.deviation, "Max Sigma": result.uci},
                         columns=TABLE_COLUMNS)
 
@@ -50,12 +51,14 @@ def format_run(result, source: str) -> str:
 def _values(args: argparse.Namespace):
     from avar.io.read import read
 
-    data = read(args.file, columns=args.column, freq=args.rate, time_unit=args.time_unit, gaps=args.gaps)
+    if args.column and len(args.column) > 1:
+        raise UsageError(f"deviation tables are of one column; --column is given {len(args.column)} times")
+    data = read(args.file, columns=args.column, rate=args.rate, time_unit=args.time_unit, gaps=args.gaps)
     names = list(data.columns)
     if len(names) != 1:
         raise UsageError(f"{args.file} has {len(names)} data columns ({', '.join(names[:6])}); "
                          "choose one with --column NAME")
-    rate = args.rate if args.rate is not None else data.freq
+    rate = args.rate if args.rate is not None else data.rate
     return names[0], data.columns[names[0]], float(rate)
 
 
@@ -94,28 +97,29 @@ def run(args: argparse.Namespace) -> int:
 
 def add_parser(commands) -> None:
     parser = commands.add_parser(
-        "deviation", help="Stable32-style tables of ADEV, OADEV, MDEV, ... of one column of phase or frequency data")
+        "deviation", help="Stable32-style tables of ADEV, OADEV, MDEV, ... of one column of phase or frequency data",
+        description="Stable32-style tables (AF, Tau, #, Alpha, Min Sigma, Sigma, Max Sigma) of the NIST SP 1065 "
+                    "deviations of one column of phase (time error, s) or fractional frequency data.")
     parser.add_argument("file", help="CSV/TSV/text, .npy/.npz, Parquet or .mat file of phase or frequency data")
     parser.add_argument("--stat", action="append", metavar="NAME", choices=DEVIATION_STATISTICS,
                         help=f"statistic (repeatable; default oadev): {', '.join(DEVIATION_STATISTICS)}")
     parser.add_argument("--data-type", choices=["phase", "freq"], required=True,
-                        help="phase (time error, s) or fractional frequency data")
-    parser.add_argument("--rate", type=float, help="sampling rate in Hz (default: from a time column, else 1)")
-    parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave", help="tau grid")
-    parser.add_argument("--column", metavar="NAME", help="the data column (needed when there are several)")
-    parser.add_argument("--confidence", type=float, default=DEFAULT_CONFIDENCE,
-                        help="confidence of Min/Max Sigma (default one sigma, 0.6827, printed 0.683 as Stable32)")
+                        help="phase (time error, s) or fractional frequency (freq) data; required")
+    parser.add_argument("--taus", choices=["octave", "decade", "all"], default="octave",
+                        help="grid of averaging times tau (s): octave (m = 1, 2, 4, ... as Stable32; the default), "
+                             "decade or all")
+    parser.add_argument("--column", action="append", metavar="NAME",
+                        help="the data column, given once (default: the file's only data column)")
+    add_confidence_arguments(parser, DEFAULT_CONFIDENCE, "Min/Max Sigma",
+                             default_text="one sigma, 0.6827, printed 0.683 as Stable32")
     parser.add_argument("--noise", type=int, choices=[2, 1, 0, -1, -2], metavar="ALPHA",
-                        help="fix the noise exponent alpha at every level, as Stable32 allows (2 white PM, "
+                        help="fix the power-law noise exponent alpha at every level, as Stable32 allows (2 white PM, "
                              "1 flicker PM, 0 white FM, -1 flicker FM, -2 random-walk FM); default: identified")
     parser.add_argument("--nan-policy", choices=["raise", "omit"], default="raise",
-                        help="NaN (gaps) in the data: refuse, or skip the terms that touch them")
-    parser.add_argument("--time-unit", choices=["s", "ms", "us", "ns"], default=None,
-                        help="unit of a numeric time column (default: from its name, else s)")
-    parser.add_argument("--gaps", choices=["error", "ignore"], default="error",
-                        help="time steps > 1.5 median steps: refuse (default) or treat the samples as contiguous")
-    parser.add_argument("--output", metavar="CSV", help="write the tables to this CSV file ('-': stdout)")
-    parser.add_argument("--plot", metavar="PNG", help="write the figure (format from its extension)")
-    parser.add_argument("--force", action="store_true", help="replace existing --output / --plot files")
+                        help="NaN (gaps) in the data: refuse (raise, the default), or skip the terms that touch "
+                             "them (omit)")
+    add_reading_arguments(parser)
+    add_output_arguments(parser, "write the tables to this CSV file, with a Stat column ('-': stdout; default: "
+                                 "none, the tables are printed)")
     parser.set_defaults(handler=run)
 

@@ -3,18 +3,22 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import replace
 
+from avar._vocabulary import REMOVED_IN
 from avar.cli.common import (
     InputFileError,
     Progress,
     UsageError,
-    confidence_alpha,
+    add_confidence_arguments,
     parse_scales,
     replicates,
     seed_number,
+    unit_label,
 )
 from avar.cli.compute import add_input_arguments, compute_from_args
+from avar.cli.compute_many import check_bag_units, series_unit
 from avar.cli.outputs import csv_text, plan_outputs, report
 
 PROCESSES = (("qn", "quantization noise"), ("wn", "white noise"), ("rw", "random walk"), ("dr", "drift"))
@@ -34,7 +38,7 @@ def imu_selections(args: argparse.Namespace, present_types) -> dict[str, list[in
 
 
 def parse_units(values: list[str] | None, imu: bool) -> dict[str, str]:
-    """``--units deg/s`` (one series), ``--units gyro=deg/s --units accel=g`` (IMU)."""
+    """The deprecated ``--units deg/s`` (one series), ``--units gyro=deg/s --units accel=g`` (IMU)."""
     if not values:
         return {}
     if not imu:
@@ -51,6 +55,19 @@ def parse_units(values: list[str] | None, imu: bool) -> dict[str, str]:
     return units
 
 
+def _units(args: argparse.Namespace, imu: bool) -> dict[str, str]:
+    """The data units: ``--gyro-units``/``--accel-units`` (an IMU's are on its result already; a series' one
+    labels the figure), or the deprecated ``--units``, with a note on stderr."""
+    if args.units:
+        if args.gyro_units or args.accel_units:
+            raise UsageError("give --gyro-units/--accel-units or the deprecated --units, not both")
+        print(f"avar fit: --units is deprecated and will be removed in avar {REMOVED_IN}; "
+              "use --gyro-units UNIT / --accel-units UNIT", file=sys.stderr)
+        return parse_units(args.units, imu)
+    unit = series_unit(args, imu)
+    return {"series": unit} if unit else {}
+
+
 def run(args: argparse.Namespace) -> int:
     from avar.fit.avlr import avlr
 
@@ -59,7 +76,8 @@ def run(args: argparse.Namespace) -> int:
                   if getattr(args, f"{name}_{suffix}")]
     if args.per_axis and not imu:
         raise UsageError("--per-axis applies to IMU fits only (name the columns with --gyro/--accel)")
-    units = parse_units(args.units, imu)
+    check_bag_units([args.file], args)
+    units = _units(args, imu)
     if per_sensor and not imu:
         raise UsageError(f"{', '.join(per_sensor)} apply to IMU fits only (name the columns with --gyro/--accel)")
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
@@ -72,17 +90,16 @@ def run(args: argparse.Namespace) -> int:
                 f"fit takes one column (--column NAME) or an IMU (--gyro/--accel); the file has {list(results)}"
             )
         selections = {name: getattr(args, name) for name, _ in PROCESSES if getattr(args, name)}
-        fit = avlr(next(iter(results.values())), ci=args.ci, B=args.B, alpha=args.alpha, seed=args.seed, **selections)
-        ylab = None
-        if units:
-            ylab = f"Allan deviation [{units['series']}]" if args.deviation else f"Allan variance [({units['series']})^2]"
+        fit = avlr(next(iter(results.values())), ci=args.ci, B=args.B, confidence=args.confidence, seed=args.seed,
+                   **selections)
+        ylab = unit_label(units["series"], args.deviation) if units else None
 
         def figure():
             return fit.plot(decomp=True, deviation=args.deviation, ylab=ylab)
     else:
         if units:
             results = replace(results, units=units)
-        fit = avlr(results, ci=args.ci, B=args.B, alpha=args.alpha, seed=args.seed, per_axis=args.per_axis,
+        fit = avlr(results, ci=args.ci, B=args.B, confidence=args.confidence, seed=args.seed, per_axis=args.per_axis,
                    **imu_selections(args, results.present_types))
 
         def figure():
@@ -95,20 +112,29 @@ def run(args: argparse.Namespace) -> int:
 
 
 def add_parser(commands) -> None:
-    fit = commands.add_parser("fit", help="Allan variance linear regression (AVLR) of a file")
+    fit = commands.add_parser(
+        "fit", help="Allan variance linear regression (AVLR) of a file",
+        description="Allan variance linear regression (AVLR, R's avlr) of one column or of an IMU: each process "
+                    "(quantization, white noise, random walk, drift) fitted on the 1-based scales you choose, "
+                    "the Scale column of 'avar compute'; optional bootstrap intervals.")
     add_input_arguments(fit)
     for name, label in PROCESSES:
-        fit.add_argument(f"--{name}", type=parse_scales, metavar="SCALES", help=f"scales of the {label}, e.g. 1:7")
+        fit.add_argument(f"--{name}", type=parse_scales, metavar="SCALES",
+                         help=f"1-based scales of the {label}, e.g. 1:7, 3 or 1,2,5 (default: not fitted)")
         for suffix, sensor in (("gyro", "gyroscopes"), ("acc", "accelerometers")):
             fit.add_argument(
-                f"--{name}-{suffix}", type=parse_scales, metavar="SCALES", help=f"scales of the {label} of the {sensor}"
+                f"--{name}-{suffix}", type=parse_scales, metavar="SCALES",
+                help=f"scales of the {label} of the {sensor} (default: those of --{name})"
             )
-    fit.add_argument("--ci", action="store_true", help="parametric bootstrap confidence intervals (series or IMU)")
-    fit.add_argument("--per-axis", action="store_true", help="IMU: one model per axis instead of per sensor type")
-    fit.add_argument("--deviation", action="store_true", help="plot the Allan deviation instead of the variance")
-    fit.add_argument("--units", action="append", metavar="UNIT",
-                     help="data unit: one for a series (deg/s), or gyro=UNIT / accel=UNIT for an IMU (repeatable)")
+    fit.add_argument("--ci", action="store_true",
+                     help="parametric bootstrap confidence intervals, series or IMU (default: none)")
+    fit.add_argument("--per-axis", action="store_true",
+                     help="IMU: one model per axis (default: one per sensor type, pooled over its axes)")
+    fit.add_argument("--deviation", action="store_true",
+                     help="plot the Allan deviation (default: the Allan variance)")
+    fit.add_argument("--units", action="append", metavar="UNIT", help=argparse.SUPPRESS)  # deprecated
     fit.add_argument("--B", type=replicates, default=100, help="bootstrap replicates (default 100)")
-    fit.add_argument("--alpha", type=confidence_alpha, default=0.05, help="1 - confidence level (default 0.05)")
-    fit.add_argument("--seed", type=seed_number, default=None, help="seed of the bootstrap")
+    add_confidence_arguments(fit, 0.95, "the bootstrap intervals", deprecated_alpha=True)
+    fit.add_argument("--seed", type=seed_number, default=None,
+                     help="seed of the bootstrap, a whole number >= 0 (default: fresh randomness)")
     fit.set_defaults(handler=run)

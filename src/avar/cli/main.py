@@ -15,9 +15,9 @@ import sys
 import threading
 import warnings
 
-from avar._validation import cap_text, check_freq
+from avar._validation import cap_text
 from avar.cli import compute, datasets, demo, deviation, fit, report
-from avar.cli.common import InputFileError, UsageError, printable
+from avar.cli.common import InputFileError, UsageError, printable, resolve_aliases
 from avar.cli.first_run import COMPILE_SECONDS, compile_notice
 from avar.cli.outputs import remove_pending
 
@@ -172,12 +172,13 @@ def _main(argv: list[str] | None) -> int:
         print(f"avar {args.command}: error: {repeated} is given twice; give it once "
               "(e.g. --wn 1:3,5 for several scales)", file=sys.stderr)
         return 2
-    if getattr(args, "freq", None) is not None:
-        try:
-            args.freq = check_freq(args.freq, "--freq")
-        except ValueError as error:
-            print(f"avar {args.command}: error: {error}", file=sys.stderr)
-            return 2
+    try:
+        notes = resolve_aliases(args)
+    except UsageError as error:
+        print(f"avar {args.command}: error: {printable(error)}", file=sys.stderr)
+        return 2
+    for note in notes:
+        print(f"avar {args.command}: {note}", file=sys.stderr)
     try:
         if args.command in COMPILE_SECONDS:  # the subcommands that run kernels: say so if they compile
             with compile_notice(args.command):

@@ -81,7 +81,9 @@ class AutoScales:
     fit : TermFit
         The joint fit the shares come from.
     levels : ndarray
-        tau (s) of the levels.
+        tau (s) of the levels (the Allan variance's name of them).
+    taus : ndarray
+        (property) The same averaging times tau (s), under the name every result shares.
     """
 
     scales: Any
@@ -97,6 +99,11 @@ class AutoScales:
         set_field(self, "shares", frozen_mapping({p: frozen_array(s) for p, s in self.shares.items()}))
         for name in ("slopes", "slope_se", "levels"):
             set_field(self, name, frozen_array(getattr(self, name)))
+
+    @property
+    def taus(self) -> np.ndarray:
+        """Averaging times tau (s) of the levels (the same as ``levels``)."""
+        return self.levels
 
     def selection(self, processes: tuple[str, ...] = ("QN", "WN", "RW", "DR")) -> dict[str, np.ndarray]:
         """The non-empty selections of ``processes``, for :func:`avar.avlr`."""

@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar._validation import check_real, check_replicates, check_seed
+from avar._validation import check_replicates, check_seed
+from avar._vocabulary import CONFIDENCE_95, check_rate, renamed, resolve_confidence
 from avar.fit.results import SUFFIXES, AvlrResult, ImuAvlrResult
 from avar.fit.slopes import PROCESSES, check_scale_selections, fit_slopes, implied_allan_deviation, per_sample_model
 from avar.imu import ACCELEROMETER, GYROSCOPE, IMU
@@ -35,9 +36,12 @@ def avlr(
     dr: Any = None,
     ci: bool = False,
     B: int = 100,
-    alpha: float = 0.05,
+    confidence: float = CONFIDENCE_95,
     seed: Any = None,
     *,
+    alpha: float | None = None,
+    rate: float | None = None,
+    freq: float | None = None,
     qn_gyro: Any = None,
     wn_gyro: Any = None,
     rw_gyro: Any = None,
@@ -55,15 +59,15 @@ def avlr(
     log-log regression of :func:`fit_slopes`: WN sigma = exp(mean(log AD +
     log(tau) / 2)), QN Q = exp(mean(log AD + log tau)) / sqrt(3), RW gamma =
     sqrt(3) exp(mean(log AD - log(tau) / 2)), DR omega = sqrt(2) exp(mean(log
-    AD - log tau)); units as in the table of :mod:`avar.fit.slopes` (with freq in
+    AD - log tau)); units as in the table of :mod:`avar.fit.slopes` (with the rate in
     Hz: sigma in u/sqrt(Hz), Q in u s, gamma in u/s^(1/2), omega in u/s).
 
     Parameters
     ----------
     x : array_like, pandas.Series or AllanVariance
         A 1-D series (its Allan variance is computed with the defaults of
-        :func:`avar.avar`: type "mo", octave grid, freq from a time index or
-        1) or an :class:`~avar.AllanVariance` of any type and freq.
+        :func:`avar.avar`: type "mo", octave grid, the rate ``rate``, else of a
+        time index, else 1 Hz) or an :class:`~avar.AllanVariance` of any type and rate.
     qn, wn, rw, dr : int, range, sequence of int or "auto", optional
         1-based scale numbers (level j of the Allan variance) on which to
         fit each process; at least one is required (or ``auto=True``).
@@ -75,10 +79,17 @@ def avlr(
         type, the pooled estimator refitted on B simulated IMUs, or per axis).
     B : int
         Bootstrap replicates (>= 2).
-    alpha : float
-        1 - confidence level, in (0, 1).
+    confidence : float
+        Confidence level of the bootstrap intervals, in (0, 1); default 0.95.
     seed : None, int or numpy.random.Generator
         Seed of the bootstrap simulations.
+    alpha : float, optional
+        R's argument: 1 - ``confidence`` (``alpha=0.05`` is ``confidence=0.95``), kept
+        so that R code ports line by line; give one of them.
+    rate : float, optional
+        Sampling rate (Hz) of a series ``x`` (an Allan variance or IMU carries its own).
+    freq : float, optional
+        R's name of ``rate`` (as in :func:`avar.avar`); give one of them.
     qn_gyro, wn_gyro, rw_gyro, dr_gyro, qn_acc, wn_acc, rw_acc, dr_acc
         For an :class:`~avar.ImuAllanVariance` (or :class:`~avar.IMU`) ``x``
         only: the scales of each process of the gyroscopes and the
@@ -104,8 +115,8 @@ def avlr(
     ``B`` times at the length ``N`` and rate of the Allan variance, computes
     the same estimator at the same averaging factors, refits on the same
     scales and reports 2 theta - mean(theta*), the bootstrap SD and the
-    intervals estimate -/+ z_{1-alpha/2} SD. Unlike R ``avar`` 0.1.3 it
-    simulates at the data's rate (R always used freq = 1) and uses the
+    intervals estimate -/+ z SD, z the normal quantile of (1 + confidence) / 2.
+    Unlike R ``avar`` 0.1.3 it simulates at the data's rate (R always used freq = 1) and uses the
     normal quantile (R used the density, so its intervals were 8 times
     too narrow). A progress bar is drawn on stderr when ``B * N`` is large
     and stderr is a terminal.
@@ -128,6 +139,11 @@ def avlr(
         Estimate     SD  Lower  Upper
     WN     0.984  0.006  0.972  0.997
     """
+    level = resolve_confidence(confidence, alpha, deprecated=False)
+    rate, rate_name = renamed("rate", rate, "freq", freq, deprecated=False)
+    if rate is not None and isinstance(x, (AllanVariance, ImuAllanVariance, IMU)):
+        raise ValueError(f"{rate_name} applies to a series; this {type(x).__name__} carries its own rate "
+                         f"({x.freq:g} Hz)")
     imu_requested = {
         GYROSCOPE: {"QN": qn_gyro, "WN": wn_gyro, "RW": rw_gyro, "DR": dr_gyro},
         ACCELEROMETER: {"QN": qn_acc, "WN": wn_acc, "RW": rw_acc, "DR": dr_acc},
@@ -138,18 +154,23 @@ def avlr(
     if isinstance(x, (ImuAllanVariance, IMU)):
         if any(v is not None for v in (qn, wn, rw, dr)):
             raise ValueError("IMU data take qn_gyro .. dr_acc (and per_axis), not qn/wn/rw/dr")
-        bootstrap = _check_bootstrap(ci, B, alpha) if ci is not False else None
+        bootstrap = _check_bootstrap(ci, B, level) if ci is not False else None
         return _imu_avlr(x, imu_requested, bool(per_axis), bool(auto), bootstrap, check_seed(seed))
     given = sorted(p.lower() + SUFFIXES[kind] for kind, sel in imu_requested.items() for p, v in sel.items()
                    if v is not None)
     if given or per_axis:
         raise ValueError(f"{given or ['per_axis']} apply to IMU data only; for one series use qn, wn, rw, dr")
-    av = x if isinstance(x, AllanVariance) else allan_variance(x)
+    if isinstance(x, AllanVariance):
+        av = x
+    elif rate is None:
+        av = allan_variance(x)
+    else:
+        av = allan_variance(x, "mo", check_rate(rate, rate_name))
     if len(av) < 2:
         raise ValueError(f"x has an Allan variance of {len(av)} level(s); AVLR needs at least 2 levels")
     requested = resolve_auto({"QN": qn, "WN": wn, "RW": rw, "DR": dr}, av, bool(auto))
     selections = check_scale_selections(requested, len(av))
-    replicates, alpha = _check_bootstrap(ci, B, alpha)
+    replicates, (level, significance) = _check_bootstrap(ci, B, level)
     seed = check_seed(seed)
 
     fit = fit_channels({None: av}, selections, av.freq, per_axis=False)
@@ -158,7 +179,7 @@ def avlr(
     if ci:
         from avar.fit.bootstrap import parametric_bootstrap
 
-        table = parametric_bootstrap(estimates, fit.models[None], av, selections, replicates, alpha, seed)
+        table = parametric_bootstrap(estimates, fit.models[None], av, selections, replicates, significance, seed)
     return AvlrResult(
         estimates=estimates,
         scales_used=selections,
@@ -167,19 +188,17 @@ def avlr(
         implied_ad_decomp=fit.decomposition[None],
         model=fit.models[None],
         ci=table,
-        alpha=alpha if ci else None,
+        confidence=level if ci else None,
         replicates=replicates if ci else None,
     )
 
 
-def _check_bootstrap(ci: Any, B: Any, alpha: Any) -> tuple[int, float]:
+def _check_bootstrap(ci: Any, B: Any, level: tuple[float, float]) -> tuple[int, tuple[float, float]]:
+    """(replicates, (confidence, significance)) of validated bootstrap options."""
     if not isinstance(ci, (bool, np.bool_)):
         raise TypeError(f"ci must be True or False, got {ci!r}")
     replicates = check_replicates(B, "B", minimum=2)
-    alpha = check_real(alpha, "alpha")
-    if not 0.0 < alpha < 1.0:
-        raise ValueError(f"alpha must be in (0, 1) (e.g. 0.05 for 95% intervals), got {alpha!r}")
-    return replicates, alpha
+    return replicates, level
 
 
 @dataclass(frozen=True)
@@ -261,7 +280,8 @@ def _pooled(channels: Mapping[str, AllanVariance]) -> AllanVariance:
 
 
 def _imu_avlr(imu_av: Any, requested: Mapping[str, Mapping[str, Any]], per_axis: bool,
-              auto: bool = False, bootstrap: tuple[int, float] | None = None, seed: Any = None) -> ImuAvlrResult:
+              auto: bool = False, bootstrap: tuple[int, tuple[float, float]] | None = None,
+              seed: Any = None) -> ImuAvlrResult:
     """One :func:`fit_channels` per sensor type of an IMU (R ``avlr.imu_avar``)."""
     if isinstance(imu_av, IMU):
         imu_av = allan_variance(imu_av)
@@ -301,7 +321,7 @@ def _imu_avlr(imu_av: Any, requested: Mapping[str, Mapping[str, Any]], per_axis:
             from avar.fit.bootstrap import imu_bootstrap
 
             intervals[kind] = imu_bootstrap(fit.estimates, fit.models, channels, selections, per_axis,
-                                            *bootstrap, rng)
+                                            bootstrap[0], bootstrap[1][1], rng)
         models.update(fit.models)
         implied.update(fit.implied)
         decomposition.update(fit.decomposition)
@@ -314,6 +334,6 @@ def _imu_avlr(imu_av: Any, requested: Mapping[str, Mapping[str, Any]], per_axis:
         implied_ad={name: implied[name] for name in imu_av.channels},
         implied_ad_decomp={name: decomposition[name] for name in imu_av.channels},
         ci=intervals if bootstrap is not None else None,
-        alpha=bootstrap[1] if bootstrap is not None else None,
+        confidence=bootstrap[1][0] if bootstrap is not None else None,
         replicates=bootstrap[0] if bootstrap is not None else None,
     )

@@ -89,17 +89,17 @@ def bootstrap_estimates(
     return estimates
 
 
-def bootstrap_table(estimates: pd.Series, replicates: Mapping[str, np.ndarray], alpha: float) -> pd.DataFrame:
+def bootstrap_table(estimates: pd.Series, replicates: Mapping[str, np.ndarray], significance: float) -> pd.DataFrame:
     """Bias-corrected estimates, bootstrap SDs and normal intervals.
 
     Estimate = 2 theta - mean(theta*), SD = sd(theta*) (ddof 1),
     Lower/Upper = Estimate -/+ z SD with z the normal *quantile*
-    ``norm.isf(alpha / 2)`` (R ``avar`` 0.1.3 used the density
-    ``dnorm(1 - alpha/2)`` = 0.248 for alpha = 0.05, 8 times too narrow).
+    ``norm.isf(significance / 2)``, significance = 1 - confidence (R ``avar`` 0.1.3
+    used the density ``dnorm(1 - alpha/2)`` = 0.248 for its alpha = 0.05, 8 times too narrow).
     """
     from scipy.stats import norm  # scipy.stats is heavy: loaded on first use
 
-    z = norm.isf(alpha / 2.0)  # not ppf(1 - alpha/2), which rounds to inf for alpha < 1e-16
+    z = norm.isf(significance / 2.0)  # not ppf(1 - s/2), which rounds to inf for s < 1e-16
     means = np.array([replicates[p].mean() for p in estimates.index])
     sds = np.array([replicates[p].std(ddof=1) for p in estimates.index])
     corrected = 2.0 * estimates.to_numpy() - means
@@ -111,7 +111,7 @@ def bootstrap_table(estimates: pd.Series, replicates: Mapping[str, np.ndarray], 
 
 def parametric_bootstrap(
     estimates: pd.Series, model: NoiseModel, av: AllanVariance, selections: Mapping[str, np.ndarray],
-    replicates: int, alpha: float, seed: Any = None,
+    replicates: int, significance: float, seed: Any = None,
 ) -> pd.DataFrame:
     """The interval table of :func:`avar.avlr` with ``ci=True``.
 
@@ -120,12 +120,13 @@ def parametric_bootstrap(
     """
     long_run = replicates * av.n >= PROGRESS_MIN_SAMPLES and getattr(sys.stderr, "isatty", bool)()
     draws = bootstrap_estimates(model, av, selections, replicates, seed, show_progress if long_run else None)
-    return bootstrap_table(estimates, draws, alpha)
+    return bootstrap_table(estimates, draws, significance)
 
 
 def imu_bootstrap(
     estimates: pd.Series | pd.DataFrame, models: Mapping[str, NoiseModel], channels: Mapping[str, AllanVariance],
-    selections: Mapping[str, np.ndarray], per_axis: bool, replicates: int, alpha: float, rng: np.random.Generator,
+    selections: Mapping[str, np.ndarray], per_axis: bool, replicates: int, significance: float,
+    rng: np.random.Generator,
 ) -> pd.DataFrame:
     """Bootstrap table of the AVLR of one IMU sensor type.
 
@@ -138,9 +139,9 @@ def imu_bootstrap(
     """
     if per_axis:  # estimates: one row per channel, in channel order (index: axis labels)
         frames = {label: bootstrap_table(estimates.iloc[k], bootstrap_estimates(
-                  models[name], channels[name], selections, replicates, rng), alpha)
+                  models[name], channels[name], selections, replicates, rng), significance)
                   for k, (label, name) in enumerate(zip(estimates.index, channels))}
         return pd.concat(frames, names=["Axis", "Process"])
     draws = [bootstrap_estimates(models[name], av, selections, replicates, rng) for name, av in channels.items()]
     pooled = {p: np.exp(np.mean([np.log(d[p]) for d in draws], axis=0)) for p in selections}
-    return bootstrap_table(estimates, pooled, alpha)
+    return bootstrap_table(estimates, pooled, significance)

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from avar._frozen import frozen_array, frozen_frame, frozen_mapping, frozen_series
+from avar._vocabulary import deprecated_significance
 from avar.fit.slopes import format_scales, parameter_label
 from avar.imu import ACCELEROMETER, GYROSCOPE
 from avar.models import NoiseModel
@@ -45,13 +46,15 @@ class AvlrResult:
     implied_ad_decomp : Mapping[str, ndarray]
         Implied Allan deviation of every process at every level.
     model : NoiseModel
-        The fitted model in per-sample parameters at ``av.freq`` (see
+        The fitted model in per-sample parameters at the data's rate ``av.freq`` (see
         :func:`per_sample_model`), ready to ``simulate``.
     ci : pandas.DataFrame or None
         With ``avlr(..., ci=True)``: index = process, columns ``Estimate``
         (bias-corrected 2 theta - mean(theta*)), ``SD``, ``Lower``, ``Upper``.
-    alpha, replicates : float or None, int or None
-        1 - confidence level and number of bootstrap replicates of ``ci``.
+    confidence, replicates : float or None, int or None
+        Confidence level and number of bootstrap replicates of ``ci``.
+    taus : ndarray
+        (property) Averaging times tau (s) of the levels of ``av``.
     """
 
     estimates: pd.Series
@@ -61,7 +64,7 @@ class AvlrResult:
     implied_ad_decomp: Mapping[str, np.ndarray]
     model: NoiseModel
     ci: pd.DataFrame | None = None
-    alpha: float | None = None
+    confidence: float | None = None
     replicates: int | None = None
 
     def __post_init__(self) -> None:
@@ -78,6 +81,16 @@ class AvlrResult:
     def implied_av(self) -> np.ndarray:
         """Sum of the processes' implied Allan variances at every level (independent processes add)."""
         return np.sum([d**2 for d in self.implied_ad_decomp.values()], axis=0)
+
+    @property
+    def taus(self) -> np.ndarray:
+        """Averaging times tau (s) of the fitted Allan variance's levels."""
+        return self.av.taus
+
+    @property
+    def alpha(self) -> float | None:
+        """Deprecated (removed in 0.3.0): 1 - :attr:`confidence`."""
+        return deprecated_significance(self.confidence)
 
     def summary(self) -> pd.DataFrame:
         """The estimate table, one row per process.
@@ -106,7 +119,7 @@ class AvlrResult:
         if self.ci is not None:
             lines.append(
                 f"Bootstrap (B = {self.replicates}): bias-corrected estimates, SD and "
-                f"{100 * (1 - self.alpha):g}% normal intervals"
+                f"{100 * self.confidence:g}% normal intervals"
             )
         lines.append(table.to_string(float_format=lambda v: f"{v:.6g}"))
         lines.append(f"Per-sample model at {format_frequency(self.av.freq)}: {self.model!r}")
@@ -167,8 +180,10 @@ class ImuAvlrResult:
         With ``ci=True``: per sensor type, the bootstrap table (columns
         ``Estimate`` (bias-corrected), ``SD``, ``Lower``, ``Upper``; index
         process, or (axis, process) per axis).
-    alpha, replicates : float or None, int or None
-        1 - confidence level and number of bootstrap replicates of ``ci``.
+    confidence, replicates : float or None, int or None
+        Confidence level and number of bootstrap replicates of ``ci``.
+    taus : ndarray
+        (property) Averaging times tau (s) of the IMU's levels (``imu_av.taus``).
 
     Examples
     --------
@@ -190,7 +205,7 @@ class ImuAvlrResult:
     implied_ad: Mapping[str, np.ndarray]
     implied_ad_decomp: Mapping[str, Mapping[str, np.ndarray]]
     ci: Mapping[str, pd.DataFrame] | None = None
-    alpha: float | None = None
+    confidence: float | None = None
     replicates: int | None = None
 
     def __post_init__(self) -> None:
@@ -225,6 +240,16 @@ class ImuAvlrResult:
         """The sensor types fitted, in order of appearance."""
         return tuple(self.estimates)
 
+    @property
+    def taus(self) -> np.ndarray:
+        """Averaging times tau (s) of the IMU's levels (see :attr:`avar.ImuAllanVariance.taus`)."""
+        return self.imu_av.taus
+
+    @property
+    def alpha(self) -> float | None:
+        """Deprecated (removed in 0.3.0): 1 - :attr:`confidence`."""
+        return deprecated_significance(self.confidence)
+
     def summary(self) -> pd.DataFrame:
         """All estimates in one table indexed by (sensor type, process).
 
@@ -258,7 +283,7 @@ class ImuAvlrResult:
             lines += ["", f" {heading}", table.to_string(float_format=lambda v: f"{v:.6g}")]
             if self.ci is not None:
                 lines += [f" Bootstrap (B = {self.replicates}): bias-corrected estimates, SD and "
-                          f"{100 * (1 - self.alpha):g}% normal intervals",
+                          f"{100 * self.confidence:g}% normal intervals",
                           self.ci[kind].to_string(float_format=lambda v: f"{v:.6g}")]
         return "\n".join(lines)
 

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from avar._vocabulary import check_rate, renamed
 from avar.imu import IMU
 from avar.io.bag_decode import decode_imu
 from avar.io.bag_storage import Db3Bag, McapBag, Ros1Bag, Untrusted
@@ -179,8 +180,8 @@ def read_messages(path: str | Path, topic: str | None = None, progress: bool | N
         raise BagError(f"{path}: not a readable ROS bag ({text})") from None
 
 
-def read_bag(path: str | Path, topic: str | None = None, freq: float | None = None, gaps: str = "error",
-             progress: bool | None = None) -> IMU:
+def read_bag(path: str | Path, topic: str | None = None, rate: float | None = None, gaps: str = "error",
+             progress: bool | None = None, *, freq: float | None = None) -> IMU:
     """The Imu messages of one topic of a bag, as an :class:`avar.IMU` (see the module notes).
 
     Parameters
@@ -189,21 +190,24 @@ def read_bag(path: str | Path, topic: str | None = None, freq: float | None = No
         ROS 1 ``.bag``; ROS 2 ``.db3`` or ``.mcap`` file, or a ROS 2 bag directory.
     topic : str, optional
         Required when the bag holds several Imu topics (the error lists them).
-    freq : float, optional
+    rate : float, optional
         Sampling rate (Hz); default: from the header stamps.
     gaps : {"error", "ignore"}
         What to do with stamp steps longer than 1.5 median steps.
     progress : bool, optional
         A progress bar on stderr (default: a terminal and more than ~10^7 values).
     """
+    rate, rate_name = renamed("rate", rate, "freq", freq, deprecated=True)
+    if rate is not None:
+        rate = check_rate(rate, rate_name)
     path = Path(path)
     name, values, stamps, received = read_messages(path, topic, progress)
     if len(values) < 2:
         raise BagError(f"{path}: topic {name!r} holds {len(values)} message(s); at least 2 are needed")
-    if freq is None:
+    if rate is None:
         if not stamps.any():
             timing = rate_of(received, "bag receive time", "ns", gaps, what=f"{path} {name} (header stamps are 0)")
         else:
             timing = rate_of(stamps, "header.stamp", "ns", gaps, what=f"{path} {name}")
-        freq = timing["freq"]
-    return IMU(values, freq, gyro=[0, 1, 2], accel=[3, 4, 5], name=name, units=UNITS)
+        rate = timing["rate"]
+    return IMU(values, rate, gyro=[0, 1, 2], accel=[3, 4, 5], name=name, units=UNITS)

@@ -12,7 +12,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar._validation import MIN_SAMPLES, check_freq
+from avar._validation import MIN_SAMPLES
+from avar._vocabulary import check_rate, renamed
 from avar.imu import IMU
 from avar.io.matlab import read_mat
 from avar.io.npy import read_npy, read_npz
@@ -96,27 +97,27 @@ def _selection(names: Sequence[str], times: list[str], columns: Any, gyro: Any, 
     return wanted
 
 
-def _check_other_clocks(table: Any, times: list[str], freq: float, time_unit: Any, source: Path) -> None:
+def _check_other_clocks(table: Any, times: list[str], rate: float, time_unit: Any, source: Path) -> None:
     """Two time columns that give different rates (100 Hz ``time``, 50 Hz ``timestamp``) are a
-    conflict the user must settle (``time_column=`` or ``--freq``); one whose rate cannot be
+    conflict the user must settle (``time_column=`` or ``--rate``); one whose rate cannot be
     read (a whole-seconds ``sec`` column) is not a clock of the samples and is left alone."""
     for name in times[1:]:
         try:
-            other = rate_of(table[name], name, time_unit, "ignore")["freq"]
+            other = rate_of(table[name], name, time_unit, "ignore")["rate"]
         except ValueError:
             continue
-        if abs(other - freq) > 0.01 * freq:
+        if abs(other - rate) > 0.01 * rate:
             raise InputFileError(
-                f"{source}: the time columns {clip(times[0], 60)} ({freq:.6g} Hz) and {clip(name, 60)} "
+                f"{source}: the time columns {clip(times[0], 60)} ({rate:.6g} Hz) and {clip(name, 60)} "
                 f"({other:.6g} Hz) disagree; name the clock of the samples (time_column=...) or pass the rate "
-                "(freq=..., --freq)")
+                "(rate=..., --rate)")
 
 
 def read(
     path: str | os.PathLike,
     columns: str | Sequence[str] | None = None,
     *,
-    freq: float | None = None,
+    rate: float | None = None,
     time_column: str | None = None,
     time_unit: str | None = None,
     gaps: str = "error",
@@ -124,6 +125,7 @@ def read(
     accel: str | Sequence[str] | None = None,
     topic: str | None = None,
     progress: bool | None = None,
+    freq: float | None = None,
 ) -> Recording | IMU:
     """Read a log: a text table, a ``.npy`` array or ``.npz`` archive, a Parquet table, a MATLAB file, or a ROS bag.
 
@@ -141,7 +143,7 @@ def read(
     columns : str or list of str, optional
         Data columns to keep (default: all but the time columns). A time column is
         never data.
-    freq : float, optional
+    rate : float, optional
         Sampling rate in Hz; default: from the time column, else 1 Hz.
     time_column : str, optional
         The column that times the samples (default: the first column named like a
@@ -191,7 +193,8 @@ def read(
         raise ValueError(f"gaps must be one of {GAP_POLICIES}, got {gaps!r}")
     if time_unit is not None and time_unit not in ("s", "ms", "us", "ns"):
         raise ValueError(f"time_unit must be 's', 'ms', 'us' or 'ns', got {time_unit!r}")
-    rate = None if freq is None else check_freq(freq)
+    rate, rate_name = renamed("rate", rate, "freq", freq, deprecated=True)
+    rate = None if rate is None else check_rate(rate, rate_name)
     source = check_path(path)
     if source.suffix.lower() in BAG_SUFFIXES or source.is_dir():
         from avar.io.bags import read_bag
@@ -199,7 +202,7 @@ def read(
         if columns is not None or gyro is not None or accel is not None:
             raise ValueError("a bag's Imu topic gives the channels; columns, gyro and accel apply to tables only")
         try:
-            return read_bag(source, topic=topic, freq=rate, gaps=gaps, progress=progress)
+            return read_bag(source, topic=topic, rate=rate, gaps=gaps, progress=progress)
         except ValueError as error:
             raise InputFileError(str(error)) from None
         except Exception as error:  # the bag library's own errors: a corrupt or unknown bag
@@ -254,17 +257,17 @@ def read(
         values.flags.writeable = False
         data[name] = values
     if rate is not None:
-        timing = {"freq": rate, "rate_source": "given", "time_column": None}
+        timing = {"rate": rate, "rate_source": "given", "time_column": None}
     elif times:
         try:
             timing = rate_of(table[times[0]], times[0], time_unit, gaps)
         except ValueError as error:
             raise InputFileError(f"{source}: {error}") from None
         if time_column is None:
-            _check_other_clocks(table, times, timing["freq"], time_unit, source)
+            _check_other_clocks(table, times, timing["rate"], time_unit, source)
     else:
-        timing = {"freq": 1.0, "rate_source": "no time column: 1 Hz, sample numbers as time"}
+        timing = {"rate": 1.0, "rate_source": "no time column: 1 Hz, sample numbers as time"}
     if gyro is not None or accel is not None:
         frame = pd.DataFrame(data, copy=False)
-        return IMU(frame, timing["freq"], gyro=gyro, accel=accel, name=source.stem)
+        return IMU(frame, timing["rate"], gyro=gyro, accel=accel, name=source.stem)
     return Recording(data, source=str(source), **timing)

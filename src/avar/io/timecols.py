@@ -161,7 +161,7 @@ def rate_of(values, name: str, unit: str | None, gaps: str = "error", what: str 
     source = f"time column {name!r}" + ("" if used in ("s", "date-time") or unit is not None
                                         or time_unit_of(name)[1] else f" (stamps in {used}, by their size)")
     return {
-        "freq": rate,
+        "rate": rate,
         "rate_source": source,
         "time_column": name,
         "jitter": jitter,

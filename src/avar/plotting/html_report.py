@@ -100,7 +100,7 @@ def report_html(report: Any, command: str | None = None, source: str | None = No
     --------
     >>> import avar
     >>> x = avar.WN(sigma2=1e-4).simulate(4_000, seed=1)
-    >>> page = report_html(avar.noise_report(x, gyro_units="rad/s", freq=100.0), command="avar report x<1>.csv")
+    >>> page = report_html(avar.noise_report(x, gyro_units="rad/s", rate=100.0), command="avar report x<1>.csv")
     >>> page.startswith("<!DOCTYPE html>"), "<svg" in page, "x&lt;1&gt;.csv" in page
     (True, True, True)
     """
@@ -118,12 +118,12 @@ def report_html(report: Any, command: str | None = None, source: str | None = No
             for figure in figures:
                 plt.close(figure)
     name = source or report.source or report.name
-    seconds = report.n / report.freq if report.freq else float("nan")
+    seconds = report.n_samples / report.rate if report.rate else float("nan")
     meta = [("Input", str(name)), ("ROS topic", report.topic or ""),
-            ("Rate", f"{report.freq:.6g} Hz"),
-            ("Length", f"{report.n} samples per channel ({seconds:.6g} s = {seconds / 3600:.3g} h)"),
+            ("Rate", f"{report.rate:.6g} Hz"),
+            ("Length", f"{report.n_samples} samples per channel ({seconds:.6g} s = {seconds / 3600:.3g} h)"),
             ("Channels", ", ".join(str(c) for c in report.channels)),
-            ("Intervals", f"{100 * (1 - report.alpha):g}% chi-squared"),
+            ("Intervals", f"{100 * report.confidence:g}% chi-squared"),
             ("Command", command or ""), ("avar version", __version__)]
     warnings = [str(w) for w in getattr(report, "warnings", ()) or ()]
     parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',

@@ -65,20 +65,20 @@ def bootstrap_fits(
     return out
 
 
-def interval_table(spec: ModelSpec, theta: np.ndarray, draws: np.ndarray, alpha: float) -> pd.DataFrame:
+def interval_table(spec: ModelSpec, theta: np.ndarray, draws: np.ndarray, significance: float) -> pd.DataFrame:
     """Estimates, bootstrap standard errors and bias-corrected normal intervals.
 
     On the unconstrained scale u (log of a variance, atanh phi) the interval is
     c -/+ z s with c = 2 u_hat - median(u*), s = IQR(u*) / 1.349 (robust to the
     few replicates where a variance collapses towards 0) and z the normal
-    quantile of 1 - alpha / 2; it is mapped back by the transform, so it respects the constraints
+    quantile of 1 - significance / 2 (significance = 1 - confidence); it is mapped back by the transform, so it respects the constraints
     (variances > 0, |phi| < 1). SE is the standard deviation of the replicate
     estimates on the parameters' own scale.
     """
     valid = draws[np.all(np.isfinite(draws), axis=1)]
     if valid.shape[0] < 2:
         raise ValueError("fewer than 2 bootstrap replicates could be refitted; increase B")
-    z = -NormalDist().inv_cdf(alpha / 2.0)  # accurate for tiny alpha, unlike inv_cdf(1 - alpha / 2)
+    z = -NormalDist().inv_cdf(significance / 2.0)  # accurate for a tiny significance, unlike inv_cdf(1 - s / 2)
     free_hat = spec.free(theta)
     free_draws = np.array([spec.free(row) for row in valid])
     q25, q50, q75 = np.percentile(free_draws, [25.0, 50.0, 75.0], axis=0)

@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar._validation import as_series, check_real, check_replicates, check_seed
+from avar._validation import as_series, check_replicates, check_seed
+from avar._vocabulary import CONFIDENCE_95, complement, resolve_confidence
 from avar.fit.gmwm.model import ModelSpec, parse_model
 from avar.fit.gmwm.objective import WEIGHTINGS, equivalent_dof, fit_av
 from avar.fit.gmwm.results import GmwmResult, ImuGmwmResult
@@ -31,7 +32,8 @@ FULL_REPLICATES = 200
 
 def gmwm(
     x: Any, model: Any = None, *, taus: Any = "octave", weights: str = "diagonal", ci: bool = False, B: int = 100,
-    alpha: float = 0.05, seed: Any = None, model_gyro: Any = None, model_acc: Any = None,
+    confidence: float = CONFIDENCE_95, seed: Any = None, model_gyro: Any = None, model_acc: Any = None,
+    alpha: float | None = None,
 ) -> GmwmResult | ImuGmwmResult:
     """Fit a sum of latent processes to the Allan variance at all scales at once (GMWM).
 
@@ -48,13 +50,13 @@ def gmwm(
     x : array_like, pandas.Series, Recording, AllanVariance, IMU or ImuAllanVariance
         A series (its "mo" Allan variance is computed on ``taus``; the rate
         comes from a time index or a one-column Recording, else 1 Hz), an Allan variance of any type
-        (with its ``n``, fitted on its own levels), or IMU data.
+        (with its ``n_samples``, fitted on its own levels), or IMU data.
     model : str, process class, list or NoiseModel
         The processes to fit: ``"WN + RW + AR1"``, ``[avar.WN, avar.AR1]``, or
         instances whose values start the optimizer (``avar.WN(sigma2=1) +
         avar.RW(gamma2=1e-6)``). Any ``Process`` subclass (flicker noise
         included) works; see :mod:`avar.fit.gmwm.model` for the constraints
-        (variances > 0 by a log, |phi| < 1 by atanh). Repeated AR1 terms are
+        (variances > 0 by a log, ``|phi| < 1`` by atanh). Repeated AR1 terms are
         ordered by phi (correlation time).
     taus : "octave" or as in :func:`avar.avar`
         Scales: ``"octave"`` is m = 1, 2, 4, ... 2**(floor(log2 N) - 1) (the
@@ -79,8 +81,8 @@ def gmwm(
         :func:`avar.fit.gmwm.bootstrap.interval_table`).
     B : int
         Bootstrap replicates (>= 2).
-    alpha : float
-        1 - confidence level, in (0, 1).
+    confidence : float
+        Confidence level of the bootstrap intervals, in (0, 1); default 0.95.
     seed : None, int or numpy.random.Generator
         Seed of the bootstraps.
     model_gyro, model_acc
@@ -121,10 +123,9 @@ def gmwm(
         raise TypeError(f"ci must be True or False, got {ci!r}")
     replicates = check_replicates(B, "B", minimum=2)
     seed = check_seed(seed)
-    alpha = check_real(alpha, "alpha")
-    if not 0.0 < alpha < 1.0:
-        raise ValueError(f"alpha must be in (0, 1) (e.g. 0.05 for 95% intervals), got {alpha!r}")
-    options = {"weights": weights, "ci": bool(ci), "replicates": replicates, "alpha": alpha}
+    confidence, significance = resolve_confidence(confidence, alpha)
+    options = {"weights": weights, "ci": bool(ci), "replicates": replicates, "confidence": confidence,
+               "significance": significance}
     if isinstance(x, (IMU, ImuAllanVariance)):
         if model is not None:
             raise ValueError("IMU data take model_gyro and model_acc (one model per sensor type), not model")
@@ -147,18 +148,24 @@ def empirical_allan_variance(x: Any, taus: Any) -> AllanVariance:
         if len(x.names) != 1:
             raise ValueError(f"x is a Recording of {len(x.names)} columns {list(x.names)}; fit one column, "
                              "e.g. avar.gmwm(recording[name], ...) with the rate given, or read an IMU")
-        values, rate = as_series(x[x.names[0]], x.freq)
+        values, rate = as_series(x[x.names[0]], x.rate, rate_name="rate")
     else:
         values, rate = as_series(x, None)
     grid = octave_factors(values.size) / rate if isinstance(taus, str) and taus == "octave" else taus
-    return allan_variance(values, type="mo", freq=rate, taus=grid)
+    return allan_variance(values, "mo", rate, taus=grid)
 
 
 def fit_allan_variance(
     av: AllanVariance, spec: ModelSpec, *, weights: str = "diagonal", ci: bool = False, replicates: int = 100,
-    alpha: float = 0.05, seed: Any = None,
+    confidence: float = 0.95, significance: float | None = None, seed: Any = None,
 ) -> GmwmResult:
-    """The GMWM fit of one validated Allan variance: the one implementation for series and IMU channels."""
+    """The GMWM fit of one validated Allan variance: the one implementation for series and IMU channels.
+
+    ``significance`` (1 - ``confidence``, its :func:`~avar._validation.complement` by default) sets the
+    intervals' normal quantile.
+    """
+    if significance is None:
+        significance = complement(confidence)
     factors = np.asarray(av.averaging_factors, dtype=np.int64)
     nu_hat = np.asarray(av.allan, dtype=np.float64)
     if not np.all(np.isfinite(nu_hat) & (nu_hat > 0)):
@@ -188,13 +195,13 @@ def fit_allan_variance(
         from avar.fit.gmwm.bootstrap import bootstrap_fits, interval_table
 
         draws = bootstrap_fits(spec, fit, av.n, factors, av.type, edf, weights, replicates, rng)
-        table = interval_table(spec, fit.theta, draws, alpha)
+        table = interval_table(spec, fit.theta, draws, significance)
     decomposition = {label: np.asarray(p.theoretical_av(factors), dtype=np.float64)
                      for label, p in zip(spec.component_labels, model.components)}
     return GmwmResult(
         estimates=pd.Series(fit.theta, index=list(spec.labels), dtype=np.float64),
         model=model, av=av, implied_av=np.sum(list(decomposition.values()), axis=0), decomposition=decomposition,
-        objective=fit.objective, weights=weights, ci=table, alpha=alpha if ci else None,
+        objective=fit.objective, weights=weights, ci=table, confidence=confidence if ci else None,
         replicates=replicates if ci else None, converged=fit.converged,
     )
 
@@ -202,7 +209,7 @@ def fit_allan_variance(
 def _imu_gmwm(x: Any, models: dict[str, Any], taus: Any, seed: Any, options: dict[str, Any]) -> ImuGmwmResult:
     """One :func:`fit_allan_variance` per channel, with the model of its sensor type."""
     if isinstance(x, IMU):
-        grid = octave_factors(x.n) / x.freq if isinstance(taus, str) and taus == "octave" else taus
+        grid = octave_factors(x.n_samples) / x.rate if isinstance(taus, str) and taus == "octave" else taus
         x = allan_variance(x, taus=grid)
     elif not (isinstance(taus, str) and taus == "octave"):
         raise ValueError("taus applies to an IMU; an ImuAllanVariance is fitted on its own levels")

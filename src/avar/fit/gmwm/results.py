@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from avar._frozen import frozen_array, frozen_frame, frozen_mapping, frozen_series
+from avar._vocabulary import deprecated_significance
 from avar.fit.gmwm.model import continuous_parameters
 from avar.models import NoiseModel
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
@@ -43,10 +44,12 @@ class GmwmResult:
         ``"diagonal"``, ``"full"``, ``"efficient"`` or ``"identity"``.
     ci : pandas.DataFrame or None
         With ``ci=True``: ``Estimate``, ``SE``, ``Lower``, ``Upper`` per parameter.
-    alpha, replicates : float, int or None
-        1 - confidence level and bootstrap replicates (with ``ci=True``).
+    confidence, replicates : float, int or None
+        Confidence level of ``ci`` and bootstrap replicates (with ``ci=True``).
     converged : bool
         Whether the optimizer reported convergence.
+    taus : ndarray
+        (property) Averaging times tau (s) of the levels of ``av``.
     """
 
     estimates: pd.Series
@@ -57,7 +60,7 @@ class GmwmResult:
     objective: float
     weights: str
     ci: pd.DataFrame | None = None
-    alpha: float | None = None
+    confidence: float | None = None
     replicates: int | None = None
     converged: bool = True
 
@@ -73,6 +76,16 @@ class GmwmResult:
     def implied_ad(self) -> np.ndarray:
         """Implied Allan deviation sqrt(implied_av)."""
         return np.sqrt(self.implied_av)
+
+    @property
+    def taus(self) -> np.ndarray:
+        """Averaging times tau (s) of the fitted Allan variance's levels."""
+        return self.av.taus
+
+    @property
+    def alpha(self) -> float | None:
+        """Deprecated (removed in 0.3.0): 1 - :attr:`confidence`."""
+        return deprecated_significance(self.confidence)
 
     @property
     def continuous(self) -> pd.Series:
@@ -100,7 +113,7 @@ class GmwmResult:
                 f"{len(self.av)} scales, N = {self.av.n}, freq = {self.av.freq:g} Hz, weights = {self.weights}, "
                 f"objective = {self.objective:.4g}")
         if self.ci is not None:
-            head += f", {100 * (1 - self.alpha):g}% bootstrap intervals (B = {self.replicates})"
+            head += f", {100 * self.confidence:g}% bootstrap intervals (B = {self.replicates})"
         return f"{head}\n{self.summary().to_string()}\nContinuous time:\n{self.continuous.to_string()}"
 
     def __str__(self) -> str:
@@ -126,6 +139,8 @@ class ImuGmwmResult:
         The Allan variances that were fitted.
     fits : Mapping[str, GmwmResult]
         One fit per channel, in channel order.
+    taus : ndarray
+        (property) Averaging times tau (s) of the IMU's levels (``imu_av.taus``).
     """
 
     imu_av: ImuAllanVariance
@@ -136,6 +151,11 @@ class ImuGmwmResult:
 
     def __getitem__(self, channel: str) -> GmwmResult:
         return self.fits[channel]
+
+    @property
+    def taus(self) -> np.ndarray:
+        """Averaging times tau (s) of the IMU's levels (see :attr:`avar.ImuAllanVariance.taus`)."""
+        return self.imu_av.taus
 
     def summary(self) -> pd.DataFrame:
         """The channels' summaries stacked, indexed by (channel, parameter)."""

@@ -83,7 +83,7 @@ def kalibr_fields(report: Any, rostopic: str | None = None, update_rate: float |
     --------
     >>> import avar
     >>> x = (avar.WN(sigma2=4e-6) + avar.RW(gamma2=1e-12)).simulate(400_000, seed=3)
-    >>> fields = avar.noise_report(x, gyro_units="rad/s", freq=200.0).kalibr()
+    >>> fields = avar.noise_report(x, gyro_units="rad/s", rate=200.0).kalibr()
     >>> list(fields)
     ['gyroscope_noise_density', 'gyroscope_random_walk', 'rostopic', 'update_rate']
     >>> round(fields["gyroscope_noise_density"], 6), fields["update_rate"]
@@ -120,7 +120,7 @@ def kalibr_fields(report: Any, rostopic: str | None = None, update_rate: float |
     topic = rostopic if rostopic is not None else (report.topic or DEFAULT_TOPIC)
     if not isinstance(topic, str) or not topic:
         raise TypeError(f"rostopic must be a non-empty string, got {topic!r}")
-    rate = nominal_rate(float(report.freq)) if update_rate is None else float(update_rate)
+    rate = nominal_rate(float(report.rate)) if update_rate is None else float(update_rate)
     if not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"update_rate must be a finite rate > 0 (Hz), got {update_rate!r}")
     fields["rostopic"] = topic

@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from avar._validation import as_series, check_real
+from avar._validation import as_series
+from avar._vocabulary import CONFIDENCE_95, check_rate, renamed, resolve_confidence
 from avar.fit.gmwm import octave_factors
 from avar.fit.report.checks import FIT_SHARE, data_warnings, fit_check, unit_warnings
 from avar.fit.report.noise_terms import ACCEL, GYRO, check_unit
@@ -27,6 +28,7 @@ from avar.fit.report.rows import channel_rows, minimum_row
 from avar.fit.report.sensor_fit import SensorFit, fit_sensor_model
 from avar.fit.report.uncertainty import non_overlapping_fit, with_level_covariance
 from avar.imu import IMU
+from avar.recording import Recording
 from avar.stability.allan.estimator import avar as allan_variance
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 
@@ -77,41 +79,50 @@ def _grid(taus: Any, n: int, rate: float) -> Any:
 
 def _estimator(robust: bool, type: str) -> Any:
     """The Allan variance of one series: the plain estimator, or the robust one (``type="mo"`` only)."""
+    # the rate goes by position: ``freq`` in avar() (R's name), ``rate`` in the estimators that take it
     if not robust:
-        return lambda values, freq, taus: allan_variance(values, type=type, freq=freq, taus=taus)
+        return lambda values, rate, taus: allan_variance(values, type, rate, taus=taus)
     if type != "mo":
         raise ValueError(f"robust=True estimates the maximal-overlap Allan variance; type must be 'mo', got {type!r}")
     from avar.stability.robust.estimator import robust_allan_variance
 
-    return lambda values, freq, taus: robust_allan_variance(values, freq=1.0 if freq is None else freq, taus=taus)
+    return lambda values, rate, taus: robust_allan_variance(values, 1.0 if rate is None else rate, taus=taus)
 
 
-def _channels(x: Any, freq: Any, gyro: Any, accel: Any, taus: Any, type: str, single_kind: str | None,
-              robust: bool = False) -> tuple:
+def _has_columns(x: Any) -> bool:
+    """A table of named columns with a rate: a Recording, or an object like one (``.columns``, ``.rate`` or ``.freq``)."""
+    return isinstance(x, Recording) or (hasattr(x, "columns") and (hasattr(x, "rate") or hasattr(x, "freq")))
+
+
+def _channels(x: Any, rate: Any, gyro: Any, accel: Any, taus: Any, type: str, single_kind: str | None,
+              robust: bool = False, rate_name: str = "rate") -> tuple:
     """([(name, sensor type, AllanVariance, values or None)], source, topic) from any accepted input."""
     estimate = _estimator(robust, type)
     if isinstance(x, IMU):
         rows = []
         for name, kind in zip(x.channels, x.sensor_types):
             values = np.asarray(x[name], dtype=np.float64)
-            av = estimate(values, x.freq, _grid(taus, x.n, x.freq))
+            av = estimate(values, x.rate, _grid(taus, x.n_samples, x.rate))
             rows.append((name, kind, av, values))
-        return rows, getattr(x, "name", None), None
+        return rows, None, None
     if robust and isinstance(x, (ImuAllanVariance, AllanVariance)):
         raise ValueError("robust=True needs the samples: give the series, table, IMU or recording, not an Allan variance")
     if isinstance(x, ImuAllanVariance):
         rows = [(name, kind, av, None) for (name, av), kind in zip(x.channels.items(), x.sensor_types)]
-        return rows, x.sensor, None
+        return rows, None, None
     if isinstance(x, AllanVariance):
         return [(x.name or "x", single_kind, x, None)], None, None
-    if isinstance(x, pd.DataFrame) or (hasattr(x, "columns") and hasattr(x, "freq")):
+    if isinstance(x, pd.DataFrame) or _has_columns(x):
         if isinstance(x, pd.DataFrame):
             values = {str(c): x[c] for c in x.columns}
-            rate, source, topic = freq, None, None
+            source, topic = None, None
         else:
             values = _columns_of(x)
-            rate = x.freq if freq is None else freq
-            source, topic = getattr(x, "source", None), getattr(x, "topic", None)
+            if rate is None:
+                rate = x.rate if hasattr(x, "rate") else x.freq
+            source, topic = getattr(x, "source", None) or None, getattr(x, "topic", None)
+        if rate is not None:
+            rate = check_rate(rate, rate_name)
         rows = []
         for name, kind in _selected(list(values), gyro, accel):
             series = np.asarray(values[name], dtype=np.float64)
@@ -121,19 +132,19 @@ def _channels(x: Any, freq: Any, gyro: Any, accel: Any, taus: Any, type: str, si
             raise ValueError("x has no data column")
         return rows, None if source is None else str(source), None if topic is None else str(topic)
     name = getattr(x, "name", None) if isinstance(x, pd.Series) else None
-    series, rate = as_series(x, freq)
+    series, rate = as_series(x, rate, rate_name=rate_name)
     series = np.asarray(series, dtype=np.float64)
-    av = estimate(series, rate, _grid(taus, series.size, rate))  # the rate of freq, else of a time index, else 1 Hz
+    av = estimate(series, rate, _grid(taus, series.size, rate))  # the rate given, else of a time index, else 1 Hz
     return [(str(name) if name is not None else "x", single_kind, av, series)], None, None
 
 
-def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray, np.ndarray]:
-    """The selected model of one Allan variance and its 1 - alpha band (lower, upper deviation).
+def fit_channel(av: AllanVariance, significance: float) -> tuple[SensorFit, np.ndarray, np.ndarray]:
+    """The selected model of one Allan variance and its band of confidence 1 - significance (lower, upper deviation).
 
     The fit weighs the levels by their degrees of freedom (N - 2m + 1) / m;
     the band uses Greenhall's EDF of the overlapping Allan variance at the
-    noise type of the fitted model's local slope (alpha = -1 - d log AV / d log
-    tau, rounded into -2..2). When the selected model fits fewer than 90 % of
+    noise type of the fitted model's local slope (the power-law noise exponent
+    alpha = -1 - d log AV / d log tau, rounded into -2..2). When the selected model fits fewer than 90 % of
     the levels, the selection is extended by the terms the data demand (``check`` of
     :func:`~avar.fit.report.sensor_fit.fit_sensor_model`). The parameters'
     covariance is the sandwich around the exact covariance of the
@@ -146,30 +157,30 @@ def fit_channel(av: AllanVariance, alpha: float) -> tuple[SensorFit, np.ndarray,
     counts = np.maximum(av.n - 2 * factors + 1, 1)
     nu_hat, adev = np.asarray(av.allan, dtype=np.float64), np.asarray(av.adev, dtype=np.float64)
     fit = fit_sensor_model(factors, nu_hat, counts / factors)
-    lower, upper, edf = _band(av, fit.implied(factors), alpha)
+    lower, upper, edf = _band(av, fit.implied(factors), significance)
 
     def share(implied: np.ndarray) -> float:
         return float(np.mean(fit_check("", av.levels, adev, lower, upper, np.sqrt(implied))[0]))
 
     if share(fit.implied(factors)) < FIT_SHARE:
         fit = fit_sensor_model(factors, nu_hat, counts / factors, check=share)
-        lower, upper, edf = _band(av, fit.implied(factors), alpha)
+        lower, upper, edf = _band(av, fit.implied(factors), significance)
     if av.type != "mo":  # the exact covariance is the maximal-overlap estimator's
         return non_overlapping_fit(fit, av.n, 2.0 * fit.implied(factors) ** 2 / edf), lower, upper
     return with_level_covariance(fit, av.n), lower, upper
 
 
-def _band(av: AllanVariance, implied: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Lower and upper 1 - alpha chi-squared bounds of the deviation and Greenhall's EDF, at the model's noise
-    types (power-law alpha: AV slope mu gives -1 - mu, and 2 (white PM) below -1.5), for the estimator's
-    overlap."""
+def _band(av: AllanVariance, implied: np.ndarray, significance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Lower and upper chi-squared bounds (confidence 1 - significance) of the deviation and Greenhall's EDF, at
+    the model's noise types (power-law alpha: AV slope mu gives -1 - mu, and 2 (white PM) below -1.5), for the
+    estimator's overlap."""
     from avar.stability.uncertainty.edf import chi2_bounds, greenhall_edf
 
     factors = np.asarray(av.averaging_factors, dtype=np.int64)
     slope = np.gradient(np.log(implied), np.log(factors)) if factors.size > 1 else np.zeros(1)
     noise = np.where(slope < -1.5, 2, np.clip(np.rint(-1.0 - slope), -2, 1)).astype(np.int64)
     edf = greenhall_edf(noise, 2, factors, av.n + 1, overlapping=av.type == "mo", modified=False)
-    lower, upper = chi2_bounds(np.sqrt(av.allan), edf, 1.0 - alpha)
+    lower, upper = chi2_bounds(np.sqrt(av.allan), edf, 1.0 - significance)
     return np.asarray(lower), np.asarray(upper), np.asarray(edf)
 
 
@@ -178,15 +189,19 @@ def noise_report(
     gyro_units: str | None = None,
     accel_units: str | None = None,
     *,
-    freq: float | None = None,
+    rate: float | None = None,
     gyro: Any = None,
     accel: Any = None,
-    alpha: float = 0.05,
+    confidence: float = CONFIDENCE_95,
     type: str = "mo",
     taus: Any = "octave",
     name: str | None = None,
+    source: str | None = None,
+    topic: str | None = None,
     from_bag: bool = False,
     robust: bool = False,
+    freq: float | None = None,
+    alpha: float | None = None,
 ) -> NoiseReport:
     """Noise terms of every channel of a real sensor's log, with no scales to choose.
 
@@ -196,7 +211,7 @@ def noise_report(
     Gauss-Markov and two sinusoid terms, fitted jointly at every level by
     maximum likelihood and selected by a penalized deviance
     (:func:`avar.fit.report.sensor_fit.fit_sensor_model`); then, in SI and customary
-    units with 1 - alpha intervals:
+    units with intervals of the given ``confidence``:
 
     * quantization Q, angle / velocity random walk N, bias instability B
       (IEEE 952: the flicker plateau of the Allan deviation is 0.664 B),
@@ -218,27 +233,33 @@ def noise_report(
     Parameters
     ----------
     x : array_like, pandas.Series, pandas.DataFrame, AllanVariance, IMU, ImuAllanVariance or Recording
-        A series, a table of channels, an IMU or its Allan variance, or a
-        recording (any object with ``.columns``, a DataFrame or mapping of
-        named columns, ``.freq`` in Hz and optionally ``.topic``, ``.source``).
-    gyro_units : {"rad/s", "deg/s", "deg/h"}, optional
-        Unit of the gyroscope data (default rad/s, or the IMU's own units).
+        A series, a table of channels, an :class:`~avar.IMU` or its Allan variance, or
+        a :class:`~avar.Recording` (what :func:`avar.read` returns: named columns, their
+        rate and the file they came from).
+    gyro_units : str, optional
+        Unit of the gyroscope data: ``"rad/s"`` (default, or the IMU's own units),
+        ``"deg/s"`` (``"dps"``), ``"deg/h"``; any spelling of :data:`avar.fit.report.noise_terms.UNIT_SPELLINGS`.
         For a single series, giving it makes the series a gyroscope.
-    accel_units : {"m/s^2", "g", "mg"}, optional
-        Unit of the accelerometer data (default m/s^2); as ``gyro_units``.
-    freq : float, optional
-        Sampling rate (Hz) of a series or table (a recording carries its own).
+    accel_units : str, optional
+        Unit of the accelerometer data: ``"m/s^2"`` (default), ``"g"``, ``"mg"``; as ``gyro_units``.
+    rate : float, optional
+        Sampling rate (Hz) of a series or table; default: a time index's, else 1 Hz. A
+        recording or IMU carries its own (``rate`` overrides a recording's).
     gyro, accel : str or list of str, optional
         Gyroscope / accelerometer columns of a table or recording (default:
         recognized by name: ``gyro*``, ``gx``, ``angular_velocity.*``, ``acc*``,
         ``ax``, ``linear_acceleration.*``; other columns are reported without a
         sensor type, in data units).
-    alpha : float
-        1 - confidence level of the intervals and of the band, in (0, 1).
+    confidence : float
+        Confidence level of the intervals and of the band, in (0, 1); default 0.95.
     type, taus
         Estimator and tau grid, as for :func:`avar.avar` (``"octave"``: m = 1, 2, 4, ...).
     name : str, optional
-        Label of the report (default: the IMU or recording name).
+        Label of the report (default: the IMU, recording or file name).
+    source : str, optional
+        The file the data came from (default: a recording's); a Kalibr yaml never overwrites it.
+    topic : str, optional
+        The ROS topic of the data, written as Kalibr's ``rostopic`` (default: none, ``/imu0`` in the yaml).
     from_bag : bool
         The data came from a ROS bag (SI units by definition): a non-SI unit is warned about.
     robust : bool
@@ -261,7 +282,7 @@ def noise_report(
     >>> f = 100.0
     >>> model = avar.WN.from_continuous(2e-3, f) + avar.FN(b2=1e-6) + avar.RW.from_continuous(1.5e-4, f)
     >>> x = model.simulate(360_000, seed=3)  # one hour of a gyro in deg/s
-    >>> report = avar.noise_report(x, gyro_units="deg/s", freq=f)
+    >>> report = avar.noise_report(x, gyro_units="deg/s", rate=f)
     >>> truth = {"WN": 0.12, "FN": 3.6, "RW": 32.4}   # deg/sqrt(h), deg/h, deg/h/sqrt(h)
     >>> [round(report.value("x", p, customary=True) / truth[p], 1) for p in truth]   # estimate / truth
     [1.0, 1.0, 1.0]
@@ -273,15 +294,18 @@ def noise_report(
     units = {GYRO: None if gyro_units is None else check_unit(gyro_units, GYRO, "gyro_units"),
              ACCEL: None if accel_units is None else check_unit(accel_units, ACCEL, "accel_units")}
     single_kind = GYRO if gyro_units is not None else ACCEL if accel_units is not None else None
-    alpha = check_real(alpha, "alpha")
-    if not 0.0 < alpha < 1.0:
-        raise ValueError(f"alpha must be in (0, 1) (e.g. 0.05 for 95% intervals), got {alpha!r}")
-    if name is not None and not isinstance(name, str):
-        raise TypeError(f"name must be a string, got {name!r}")
+    rate, rate_name = renamed("rate", rate, "freq", freq, deprecated=True)
+    confidence, significance = resolve_confidence(confidence, alpha)
+    for label, value in (("name", name), ("source", source), ("topic", topic)):
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"{label} must be a string, got {value!r}")
     own_units = dict(getattr(x, "units", None) or {}) if isinstance(x, (IMU, ImuAllanVariance)) else {}
     if not isinstance(robust, (bool, np.bool_)):
         raise TypeError(f"robust must be True or False, got {robust!r}")
-    channels, source, topic = _channels(x, freq, gyro, accel, taus, type, single_kind, bool(robust))
+    channels, own_source, own_topic = _channels(x, rate, gyro, accel, taus, type, single_kind, bool(robust), rate_name)
+    source = source if source is not None else own_source
+    topic = topic if topic is not None else own_topic
+    label = name or (x.name if isinstance(x, IMU) else x.sensor if isinstance(x, ImuAllanVariance) else None)
     rows, fits, avs, kinds, data_units, warnings, curves = [], {}, {}, [], [], [], []
     for channel, kind, av, values in channels:
         if len(av) < 3:
@@ -295,13 +319,13 @@ def noise_report(
             given = units[kind] or own_units.get(kind)
             unit = check_unit(given, kind, "gyro_units" if kind == GYRO else "accel_units") if given \
                 else DEFAULT_UNITS[kind]
-        fit, lower, upper = fit_channel(av, alpha)
+        fit, lower, upper = fit_channel(av, significance)
         implied = np.sqrt(fit.implied(av.averaging_factors))
         fits_level, departure = fit_check(channel, av.levels, av.adev, lower, upper, implied)
         fits[channel], avs[channel] = fit, av
         kinds.append(kind)
         data_units.append(unit)
-        rows += channel_rows(channel, kind, unit, fit, av.freq, alpha)
+        rows += channel_rows(channel, kind, unit, fit, av.freq, significance)
         rows.append(minimum_row(channel, kind, unit, av.levels, av.adev, lower, upper))
         notes = [departure] if departure else []
         if values is not None:
@@ -320,13 +344,13 @@ def noise_report(
                                     "Unit": unit or ""}))
     first = channels[0][2]
     return NoiseReport(
-        name=name or source or (channels[0][0] if len(channels) == 1 else "IMU"),
-        source=source, topic=topic, freq=first.freq, n=first.n,
+        name=label or source or (channels[0][0] if len(channels) == 1 else "IMU"),
+        source=source, topic=topic, rate=first.freq, n_samples=first.n,
         channels=tuple(c[0] for c in channels), sensor_types=tuple(kinds), units=tuple(data_units),
-        avs=avs, fits=fits, terms=pd.DataFrame(rows), alpha=alpha, curves=pd.concat(curves, ignore_index=True),
-        warnings=tuple(warnings),
+        avs=avs, fits=fits, terms=pd.DataFrame(rows), confidence=confidence,
+        curves=pd.concat(curves, ignore_index=True), warnings=tuple(warnings),
     )
 
 
 def _multi_channel(x: Any) -> bool:
-    return isinstance(x, (IMU, ImuAllanVariance, pd.DataFrame)) or (hasattr(x, "columns") and hasattr(x, "freq"))
+    return isinstance(x, (IMU, ImuAllanVariance, pd.DataFrame)) or _has_columns(x)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["GYRO_UNITS", "ACCEL_UNITS", "TERM_NAMES", "SI_UNITS", "CUSTOMARY", "check_unit", "to_si",
+__all__ = ["GYRO_UNITS", "ACCEL_UNITS", "UNIT_SPELLINGS", "TERM_NAMES", "SI_UNITS", "CUSTOMARY", "check_unit", "to_si",
            "customary", "unit_of"]
 
 G0 = 9.80665
@@ -40,6 +40,13 @@ _ALIASES = {"rad/sec": "rad/s", "dps": "deg/s", "deg/sec": "deg/s", "deg/hr": "d
             "m/s/s": "m/s^2", "m/s**2": "m/s^2", "milli-g": "mg"}
 
 GYRO, ACCEL = "Gyroscope", "Accelerometer"
+
+#: Every accepted spelling of a data unit per sensor type (any case): the canonical unit, then its aliases.
+#: Python (``gyro_units=``, ``accel_units=``) and every subcommand (``--gyro-units``, ``--accel-units``) take these.
+UNIT_SPELLINGS = {
+    kind: tuple(table) + tuple(alias for alias, unit in _ALIASES.items() if unit in table)
+    for kind, table in ((GYRO, GYRO_UNITS), (ACCEL, ACCEL_UNITS))
+}
 
 #: Display names of the terms per sensor type (None: a series of unknown type).
 TERM_NAMES = {

@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from avar._frozen import frozen_mapping
+from avar._vocabulary import deprecated_significance
 from avar.stability.allan.results import format_frequency
 
 __all__ = ["NoiseReport"]
@@ -41,10 +42,10 @@ class NoiseReport:
         Label (file, IMU or channel name), used in titles.
     source, topic : str or None
         Where the data came from (a file, a bag and its ROS topic).
-    freq : float
-        Sampling rate (Hz).
-    n : int
-        Samples per channel.
+    rate : float
+        Sampling rate (Hz); ``freq`` is the same value.
+    n_samples : int
+        Samples per channel; ``n`` is the same value.
     channels, sensor_types, units : tuple
         Channel names, ``"Gyroscope"``/``"Accelerometer"``/None, data units.
     avs : Mapping[str, AllanVariance]
@@ -53,8 +54,8 @@ class NoiseReport:
         The selected model of every channel (per-sample variances in data units).
     terms : DataFrame
         The table (see :attr:`table`).
-    alpha : float
-        1 - confidence level of the intervals.
+    confidence : float
+        Confidence level of the intervals and of the band (0.95 by default).
     curves : DataFrame
         Per channel and level: ``Channel, Tau (s), ADEV, Lower, Upper, Implied ADEV, Fits, Unit``
         (deviations in data units; ``Fits``: the implied deviation is inside the band or within 10 %).
@@ -65,15 +66,15 @@ class NoiseReport:
     name: str
     source: str | None
     topic: str | None
-    freq: float
-    n: int
+    rate: float
+    n_samples: int
     channels: tuple[str, ...]
     sensor_types: tuple[str | None, ...]
     units: tuple[str | None, ...]
     avs: Mapping[str, Any]
     fits: Mapping[str, Any]
     terms: pd.DataFrame
-    alpha: float
+    confidence: float
     curves: pd.DataFrame
     warnings: tuple[str, ...] = ()
 
@@ -87,6 +88,21 @@ class NoiseReport:
         for column in NUMERIC_COLUMNS:
             terms[column] = terms[column].astype("Float64")
         set_field(self, "terms", terms)
+
+    @property
+    def freq(self) -> float:
+        """The sampling rate in Hz (:attr:`rate`)."""
+        return self.rate
+
+    @property
+    def n(self) -> int:
+        """Samples per channel (:attr:`n_samples`)."""
+        return self.n_samples
+
+    @property
+    def alpha(self) -> float:
+        """Deprecated (removed in 0.3.0): 1 - :attr:`confidence`."""
+        return deprecated_significance(self.confidence)
 
     @property
     def table(self) -> pd.DataFrame:
@@ -108,7 +124,7 @@ class NoiseReport:
 
         >>> import avar
         >>> x = avar.WN(sigma2=1e-4).simulate(20_000, seed=1)
-        >>> round(avar.noise_report(x, gyro_units="rad/s", freq=100.0).value("x", "WN"), 5)
+        >>> round(avar.noise_report(x, gyro_units="rad/s", rate=100.0).value("x", "WN"), 5)
         0.001
         """
         rows = self.terms[(self.terms["Channel"] == channel) & (self.terms["Process"] == process)]
@@ -160,8 +176,8 @@ class NoiseReport:
 
     def describe(self) -> str:
         where = f" ({self.topic})" if self.topic else ""
-        return (f"Noise report of {self.name}{where}: {len(self.channels)} channel(s), N = {self.n}, "
-                f"freq = {format_frequency(self.freq)}, {100 * (1 - self.alpha):g}% chi-squared intervals")
+        return (f"Noise report of {self.name}{where}: {len(self.channels)} channel(s), N = {self.n_samples}, "
+                f"freq = {format_frequency(self.rate)}, {100 * self.confidence:g}% chi-squared intervals")
 
     def __str__(self) -> str:
         lines = [self.describe()]

@@ -51,13 +51,13 @@ DEG = math.pi / 180.0
 G0 = 9.80665
 
 
-def _chi2_interval(c: float, variance: float, alpha: float) -> tuple[float, float]:
+def _chi2_interval(c: float, variance: float, significance: float) -> tuple[float, float]:
     from scipy.special import chdtri
 
     if not (variance > 0 and c > 0):
         return c, c
     edf = 2.0 * c * c / variance
-    return c * edf / chdtri(edf, alpha / 2.0), c * edf / chdtri(edf, 1.0 - alpha / 2.0)
+    return c * edf / chdtri(edf, significance / 2.0), c * edf / chdtri(edf, 1.0 - significance / 2.0)
 
 
 def _row(channel: str, kind: str | None, term: str, process: str, status: str, unit: str, values: tuple,
@@ -82,8 +82,8 @@ def _ieee_row(channel: str, kind: str | None, unit: str | None, process: str, st
     return _row(channel, kind, name, process, status, unit_of(process, kind, unit), si, custom_unit, custom, note=note)
 
 
-def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFit, freq: float,
-                 alpha: float) -> list[dict[str, Any]]:
+def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFit, rate: float,
+                 significance: float) -> list[dict[str, Any]]:
     """The rows of one channel: IEEE terms (present, bound or absent), then Gauss-Markov and sinusoid terms."""
     rows = []
     by_kind: dict[str, list[int]] = {}
@@ -94,24 +94,24 @@ def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFi
         if process in by_kind:
             k = by_kind[process][0]
             c = fit.components[k].scale
-            low, high = _chi2_interval(c, fit.scale_variance(k), alpha)
+            low, high = _chi2_interval(c, fit.scale_variance(k), significance)
             rows.append(_ieee_row(channel, kind, unit, process, "present",
-                                  (convert(c, freq), convert(low, freq), convert(high, freq))))
+                                  (convert(c, rate), convert(low, rate), convert(high, rate))))
         elif process in BOUNDED:
-            bound = convert(max(term_bound(fit, process, 1.0 - alpha / 2.0), 0.0), freq)
+            bound = convert(max(term_bound(fit, process, 1.0 - significance / 2.0), 0.0), rate)
             rows.append(_ieee_row(channel, kind, unit, process, "bound", (pd.NA, 0.0, bound),
-                                  note=f"not resolved by the data: {100 * (1 - alpha / 2):g} % upper bound"))
+                                  note=f"not resolved by the data: {100 * (1 - significance / 2):g} % upper bound"))
         else:
             rows.append(_ieee_row(channel, kind, unit, process, "absent", (pd.NA,) * 3, note="rejected by the selection"))
     data_unit = unit or "u"
-    z = _normal_quantile(alpha)
+    z = _normal_quantile(significance)
     for number, k in enumerate(by_kind.get("AR1", []), start=1):
         component = fit.components[k]
         phi, c = component.shape, component.scale
-        low, high = _chi2_interval(c, fit.scale_variance(k), alpha)
+        low, high = _chi2_interval(c, fit.scale_variance(k), significance)
         spread = 1.0 / (1.0 - phi * phi)
         sigma = tuple(to_si(math.sqrt(v * spread), kind, unit) for v in (c, low, high))
-        time = -1.0 / (freq * math.log(phi))
+        time = -1.0 / (rate * math.log(phi))
         se_log = math.sqrt(max(fit.shape_variance(k), 0.0)) / (phi * abs(math.log(phi)))
         times = (time, time * math.exp(-z * se_log), time * math.exp(z * se_log))
         label = f"Gauss-Markov {number}"
@@ -121,10 +121,10 @@ def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFi
     for number, k in enumerate(by_kind.get("SIN", []), start=1):
         component = fit.components[k]
         c = component.scale
-        low, high = _chi2_interval(c, fit.scale_variance(k), alpha)
+        low, high = _chi2_interval(c, fit.scale_variance(k), significance)
         amplitude = tuple(to_si(math.sqrt(2.0 * v), kind, unit) for v in (c, low, high))
-        hertz = component.shape * freq
-        spread = z * math.sqrt(max(fit.shape_variance(k), 0.0)) * freq
+        hertz = component.shape * rate
+        spread = z * math.sqrt(max(fit.shape_variance(k), 0.0)) * rate
         rows.append(_row(channel, kind, f"Sinusoid {number} amplitude", f"SIN_{number}", "present",
                          _si_unit(kind, unit, data_unit), amplitude, tau=1.0 / hertz))
         rows.append(_row(channel, kind, f"Sinusoid {number} frequency", f"SIN_{number}.f", "present", "Hz",
@@ -155,7 +155,7 @@ def _si_unit(kind: str | None, unit: str | None, fallback: str) -> str:
     return fallback
 
 
-def _normal_quantile(alpha: float) -> float:
+def _normal_quantile(significance: float) -> float:
     from scipy.special import ndtri
 
-    return float(ndtri(1.0 - alpha / 2.0))
+    return float(ndtri(1.0 - significance / 2.0))
