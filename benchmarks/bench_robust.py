@@ -98,7 +98,7 @@ def speed(n: int) -> None:
     rng = np.random.default_rng(0)
     x = with_spikes(white_plus_walk(n, rng), rng)
     t_avar = median_time(lambda: avar.avar(x, freq=200.0), 3)
-    t_robust = median_time(lambda: avar.robust_avar(x, freq=200.0), 3)
+    t_robust = median_time(lambda: avar.robust_avar(x, rate=200.0), 3)
     t_count = median_time(lambda: avar.count_outliers(x), 3)
     print(f"speed, N = {n} (2 h at 200 Hz), 5 % spikes: avar {t_avar:.3f} s, robust_avar {t_robust:.3f} s "
           f"({t_robust / t_avar:.1f}x avar), count_outliers {t_count:.3f} s")

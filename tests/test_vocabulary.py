@@ -30,8 +30,7 @@ R_FREQ = {"avar", "avlr", "IMU", "AllanVariance", "ImuAllanVariance", "RobustAll
 #: The one function that documents ``alpha`` as 1 - confidence (R's ``avlr(..., alpha)``).
 R_ALPHA = {"avlr"}
 #: Public names whose ``rate=`` spelling is not there yet: stability/ is another owner's (see docs/conventions.md).
-RATE_PENDING = {"avar": "avar.avar() has R's freq= but no rate= yet (stability/allan/estimator.py)",
-                "robust_avar": "avar.robust_avar() takes freq= only (stability/robust/estimator.py)"}
+RATE_PENDING: dict[str, str] = {}
 #: Results with levels, and the class that holds them.
 RESULTS_WITH_TAUS = ["AllanVariance", "ImuAllanVariance", "RobustAllanVariance", "Deviation", "AvlrResult",
                      "ImuAvlrResult", "GmwmResult", "ImuGmwmResult", "AutoScales"]

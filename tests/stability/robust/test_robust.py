@@ -178,7 +178,7 @@ def test_count_outliers_of_quantized_data():
 # --------------------------------------------------------------------------- robust_avar
 def test_without_outliers_it_is_the_ordinary_allan_variance():
     x = white_plus_walk(5000, 5) + 1e6
-    res = avar.robust_avar(x, freq=100.0, taus="decade")
+    res = avar.robust_avar(x, rate=100.0, taus="decade")
     ref = avar.avar(x, type="mo", freq=100.0, taus="decade")
     assert res.outliers.count == 0 and res.type == "mo"
     np.testing.assert_array_equal(res.averaging_factors, ref.averaging_factors)
@@ -241,7 +241,7 @@ def test_resists_five_percent_spikes_of_20_sigma(seed):
     clean = white_plus_walk(n, seed)
     spiky, where = add_spikes(clean, 0.05, 20.0, seed=seed + 100)
     reference = avar.avar(clean, freq=200.0)
-    res = avar.robust_avar(spiky, freq=200.0)
+    res = avar.robust_avar(spiky, rate=200.0)
     ordinary = avar.avar(spiky, freq=200.0)
     useful = n / (2 * reference.averaging_factors) >= 100
     assert useful.sum() >= 9
@@ -287,7 +287,7 @@ def test_results_are_read_only_and_checked():
 def test_levels_follow_avar_grids():
     x = add_spikes(white_plus_walk(3000, 2), 0.02, 20.0, 3)[0]
     for taus in ("octave", "decade", "all", [0.1, 0.5, 2.0]):
-        res = avar.robust_avar(x, freq=10.0, taus=taus)
+        res = avar.robust_avar(x, rate=10.0, taus=taus)
         np.testing.assert_array_equal(res.averaging_factors, avar.avar(x, freq=10.0, taus=taus).averaging_factors)
         assert len(res.intact) == len(res) and res.freq == 10.0
     assert "robust: 60 outlying samples" in res.describe()

@@ -30,7 +30,7 @@ from avar.stability.shared.term_counts import n_differences
 
 
 def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octave", ci: str = "r",
-         confidence: float | None = None, nan_policy: str = "raise"):
+         confidence: float | None = None, nan_policy: str = "raise", *, rate: float | None = None):
     """Empirical Allan variance of a series (or of every channel of an IMU).
 
     With x_1..x_N the series, m the cluster size, tau = m / freq and
@@ -64,7 +64,8 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
     type : {"mo", "to"}
         Estimator.
     freq : float, optional
-        Sampling frequency in Hz (default 1, or the rate of the time index).
+        Sampling frequency in Hz (default 1, or the rate of the time index): R's name, an
+        alias of ``rate``.
     taus : {"octave", "decade", "all"} or array_like of float
         Tau grid; see :func:`averaging_factors`. ``"octave"`` (m = 2, 4, ...,
         2**(floor(log2 N) - 1)) reproduces the R package.
@@ -86,6 +87,8 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
         skipped: every difference of cluster means that touches a NaN is left
         out and ``n_differences`` counts those used ("mo" is then OADEV**2 of
         ``x`` as frequency data, "to" ADEV**2; see :mod:`avar.stability.allan.gaps`).
+    rate : float, optional
+        Sampling rate in Hz, the library's name for R's ``freq`` (give one of them).
 
     Returns
     -------
@@ -125,6 +128,10 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
     >>> bool(np.all((band.lci > 0) & (band.lci <= band.adev) & (band.adev <= band.uci)))
     True
     """
+    if rate is not None:
+        if freq is not None:
+            raise TypeError("give rate= or freq= (R's alias of rate), not both")
+        freq = rate
     kind = check_type(type)
     band = check_ci(ci, confidence)
     if _is_dask_array(x):

@@ -10,6 +10,7 @@ the wavelet coefficients down-weighted).
 from __future__ import annotations
 
 import sys
+import warnings
 from typing import Any
 
 import numpy as np
@@ -244,8 +245,8 @@ def fill_excess(raw: np.ndarray, factors: np.ndarray, fraction: float, scale: fl
     return np.minimum(white, raw * FILL_BIAS * fraction / (1.0 + FILL_BIAS * fraction))
 
 
-def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
-                          threshold: float = 4.0) -> RobustAllanVariance:
+def robust_allan_variance(x: Any, rate: float | None = None, taus: Any = "octave",
+                          threshold: float = 4.0, *, freq: float | None = None) -> RobustAllanVariance:
     """Allan variance ("mo") of the clean process behind a series with spikes.
 
     Outlying samples are flagged as in :func:`count_outliers` (``threshold``
@@ -305,8 +306,8 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
     ----------
     x : array_like or pandas.Series
         1-D real series (finite values).
-    freq : float
-        Sampling frequency in Hz.
+    rate : float, optional
+        Sampling rate in Hz (default: the rate of a Series' time index, else 1 Hz).
     taus : {"octave", "decade", "all"} or array_like of float
         Tau grid, as for :func:`avar.avar` (the same levels).
     threshold : float
@@ -350,7 +351,13 @@ def robust_allan_variance(x: Any, freq: float = 1.0, taus: Any = "octave",
     (True, True)
     """
     threshold = _check_threshold(threshold)
-    values, rate = _series(x, freq)
+    if freq is not None:  # the former spelling, kept for one minor release
+        if rate is not None:
+            raise TypeError("give rate= or freq= (its deprecated alias), not both")
+        warnings.warn("robust_avar(freq=...) is deprecated; use rate= (freq= goes in 0.3.0)", DeprecationWarning,
+                      stacklevel=2)
+        rate = freq
+    values, rate = _series(x, rate)
     n = values.size
     factors = averaging_factors(n, rate, taus)
     outliers = flag_outliers(values, threshold)
