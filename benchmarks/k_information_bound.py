@@ -292,7 +292,7 @@ def report_k(x: np.ndarray) -> float:
     """K from ``avar.noise_report`` (NaN unless ``present``)."""
     import avar
 
-    table = avar.noise_report(x, gyro_units="rad/s", freq=FREQ).table
+    table = avar.noise_report(x, gyro_units="rad/s", rate=FREQ).table
     row = table[table["Process"] == "RW"].iloc[0]
     return float(row["Value"]) if row["Status"] == "present" else math.nan
 

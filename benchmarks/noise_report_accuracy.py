@@ -68,7 +68,7 @@ def ros_rules(av) -> dict[str, float]:
 
 
 def report_terms(x: np.ndarray) -> tuple[dict[str, float], object]:
-    report = avar.noise_report(x, gyro_units="rad/s", freq=FREQ)
+    report = avar.noise_report(x, gyro_units="rad/s", rate=FREQ)
     values = {name: report.value("x", process) for name, process in (("ARW", "WN"), ("BI", "FN"), ("RRW", "RW"))}
     # an absent term is an error of 100%
     return {k: (0.0 if v is None else v) for k, v in values.items()}, report.avs["x"]

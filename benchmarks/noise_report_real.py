@@ -96,7 +96,7 @@ def scenario(name: str, reps: int, make, robust: bool = False, truth: dict | Non
         x = make(rng)
         start = time.perf_counter()
         kwargs = {"robust": True} if robust else {}
-        report = avar.noise_report(x, gyro_units="rad/s", freq=FREQ, **kwargs)
+        report = avar.noise_report(x, gyro_units="rad/s", rate=FREQ, **kwargs)
         times.append(time.perf_counter() - start)
         for process, truth in truth_of.items():
             row = row_of(report, process)
@@ -143,7 +143,7 @@ def real_logs() -> None:
         import pandas as pd
 
         start = time.perf_counter()
-        report = avar.noise_report(pd.DataFrame(table), gyro_units="deg/s", accel_units="g", freq=100.0,
+        report = avar.noise_report(pd.DataFrame(table), gyro_units="deg/s", accel_units="g", rate=100.0,
                                    gyro=gyro_names, accel=accel_names)
         elapsed = time.perf_counter() - start
         print(f"\n(e) {path.name}: {len(columns)} channels, report {elapsed:.2f} s, warnings: {len(report.warnings)}")
