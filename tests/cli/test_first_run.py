@@ -151,3 +151,41 @@ def test_the_warm_up_thread_is_quiet():
         assert notice.compiled == 0 and stream.getvalue() == ""
         assert cube(2) == 8  # a new signature, in the run's own thread
     assert notice.compiled == 1 and stream.getvalue().count(NOTICE) == 1
+
+
+def test_deviation_says_it_compiles_too():
+    """``avar deviation`` runs kernels: it is among the subcommands that print the notice."""
+    from avar.cli.first_run import COMPILE_SECONDS
+
+    assert {"demo", "compute", "fit", "report", "deviation", "warmup"} <= set(COMPILE_SECONDS)
+
+
+def test_after_warmup_no_command_compiles(tmp_path):
+    """``avar warmup --quick`` fills a new, empty cache; then ``avar deviation`` of phase and
+    frequency data (every statistic), ``avar compute`` and ``avar report`` of a short log, in
+    fresh processes sharing that cache, compile nothing."""
+    environment = _environment(NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
+    warm = subprocess.run([sys.executable, "-m", "avar", "warmup", "--quick"], env=environment,
+                          capture_output=True, text=True, timeout=900)
+    assert warm.returncode == 0, warm.stderr
+    families = [line for line in warm.stderr.splitlines() if line.startswith("avar warmup: ")]
+    assert len(families) == 4 and all(line.endswith(" s") for line in families)
+    assert "every kernel compiled and cached in" in warm.stdout
+    y = np.random.default_rng(5).standard_normal(3000)
+    clock = tmp_path / "clock.csv"
+    clock.write_text("y\n" + "".join(f"{v!r}\n" for v in y.tolist()))
+    log = tmp_path / "imu.csv"
+    rows = np.random.default_rng(6).standard_normal((5000, 6)) * 1e-3
+    log.write_text("time,gx,gy,gz,ax,ay,az\n" + "".join(
+        f"{i / 100}," + ",".join(repr(v) for v in row) + "\n" for i, row in enumerate(rows.tolist())))
+    from avar.stability.shared.registry import DEVIATION_STATISTICS
+
+    stats = sum((["--stat", name] for name in DEVIATION_STATISTICS), [])
+    for arguments in (["deviation", str(clock), "--data-type", "freq", *stats],
+                      ["deviation", str(clock), "--data-type", "phase", *stats],
+                      ["compute", str(log), "--output", "-"],
+                      ["report", str(log)]):
+        run = subprocess.run([sys.executable, "-m", "avar", *arguments], env=environment, capture_output=True,
+                             text=True, timeout=600)
+        assert run.returncode == 0, run.stderr
+        assert NOTICE not in run.stderr, (arguments[0], run.stderr)

@@ -28,7 +28,7 @@ QUIET_THREADS = frozenset({"avar-warm-up"})
 #: of a cold run less a warm one in benchmarks/bench_cli_startup.py (demo 3.9 s, report of
 #: a 2 h 200 Hz 6-axis log 3.7 s); compute and fit of a log beyond 2**22 samples also
 #: compile the streaming sweep (about 5 s more).
-COMPILE_SECONDS = {"demo": 5, "compute": 10, "fit": 10, "report": 5}
+COMPILE_SECONDS = {"demo": 5, "compute": 10, "fit": 10, "report": 5, "deviation": 15, "warmup": 120}
 
 
 def notice_text(command: str) -> str:

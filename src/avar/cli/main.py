@@ -16,12 +16,12 @@ import threading
 import warnings
 
 from avar._validation import cap_text
-from avar.cli import compute, datasets, demo, deviation, fit, report
+from avar.cli import compute, datasets, demo, deviation, fit, report, warmup
 from avar.cli.common import InputFileError, UsageError, printable, resolve_aliases
 from avar.cli.first_run import COMPILE_SECONDS, compile_notice
 from avar.cli.outputs import remove_pending
 
-SUBCOMMANDS = (demo, compute, deviation, fit, report, datasets)
+SUBCOMMANDS = (demo, compute, deviation, fit, report, datasets, warmup)
 SCALE_OPTIONS = frozenset(f"--{name}{suffix}" for name, _ in fit.PROCESSES for suffix in ("", "-gyro", "-acc"))
 #: Seconds between the main thread's checks for Ctrl-C while the worker runs.
 WAIT_STEP = 0.1
