@@ -95,6 +95,8 @@ _EXPORTS = {
     "GmwmResult": "avar.fit.gmwm.results",
     "ImuGmwmResult": "avar.fit.gmwm.results",
     "select_model": "avar.fit.gmwm.selection",
+    "clock_report": "avar.fit.clock.report",
+    "ClockReport": "avar.fit.clock.report",
     "plot_compare": "avar.plotting.compare",
 }
 
