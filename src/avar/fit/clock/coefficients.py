@@ -1,25 +1,25 @@
-"""Power-law coefficients h_alpha and Kalman diffusion coefficients q from per-sample processes.
+"""Power-law coefficients ``h_alpha`` and Kalman diffusion coefficients q from per-sample processes.
 
 GMWM fits processes of the fractional frequency y sampled at ``rate`` (tau0 = 1 / rate), each
-with its per-sample variance; S_y(f) = h_alpha f**alpha and the clock models' q follow exactly:
+with its per-sample variance; S_y(f) = ``h_alpha`` f**alpha and the clock models' q follow exactly:
 
 =======  ====================  =============================  =======================================
-alpha    process (parameter)   h_alpha                        Allan variance (NIST SP 1065, Table 3)
+alpha    process (parameter)   ``h_alpha``                    Allan variance (NIST SP 1065, Table 3)
 =======  ====================  =============================  =======================================
 2        QN (q2): white PM,    8 pi**2 q2 / rate**3           3 q2 / m**2 (= 3 sigma_x**2 / tau**2,
          sigma_x**2 = q2 / rate**2                            sigma_x the time error's per-sample sd)
-0        WN (sigma2)           2 sigma2 / rate                h_0 / (2 tau)
--1       FN (b2)               b2 / pi                        2 ln 2 h_-1
--2       RW (gamma2)           gamma2 rate / (2 pi**2)        (2 pi)**2 tau h_-2 / 6
+0        WN (sigma2)           2 sigma2 / rate                ``h_0`` / (2 tau)
+-1       FN (b2)               b2 / pi                        2 ln 2 ``h_-1``
+-2       RW (gamma2)           gamma2 rate / (2 pi**2)        (2 pi)**2 tau ``h_-2`` / 6
 =======  ====================  =============================  =======================================
 
 A linear frequency drift D (1/s) is DR (omega): D = omega rate.
 
 The two-state clock model (time error x, frequency y; Zucca and Tavella 2005) is
 dx = y dt + sqrt(q1) dW1, dy = sqrt(q2) dW2 (+ D dt with the third state), whose Allan variance is
-q1 / tau + q2 tau / 3: so q1 = h_0 / 2 (s) and q2 = 2 pi**2 h_-2 (1/s); white PM is measurement
+q1 / tau + q2 tau / 3: so q1 = ``h_0`` / 2 (s) and q2 = 2 pi**2 ``h_-2`` (1/s); white PM is measurement
 noise of variance r = sigma_x**2 (s**2). Flicker FM has no finite-state Markov form and is
-reported as h_-1 only.
+reported as ``h_-1`` only.
 
 References
 ----------
@@ -48,7 +48,7 @@ class KalmanQ(NamedTuple):
     q1: float
     q2: float
 
-#: alpha and h_alpha per unit of each process's parameter, as functions of the rate (Hz).
+#: alpha and ``h_alpha`` per unit of each process's parameter, as functions of the rate (Hz).
 H_OF_PROCESS = {
     "QN": (2, lambda rate: 8.0 * math.pi**2 / rate**3),
     "WN": (0, lambda rate: 2.0 / rate),
@@ -58,7 +58,7 @@ H_OF_PROCESS = {
 
 
 def h_coefficient(process: str, value: float, rate: float) -> PowerLaw:
-    """(alpha, h_alpha) of one fitted process's parameter at ``rate`` Hz.
+    """(alpha, ``h_alpha``) of one fitted process's parameter at ``rate`` Hz.
 
     >>> h_coefficient("WN", 1e-22, 1.0)   # white FM: S_y = 2 sigma2 / rate
     PowerLaw(alpha=0, h=2e-22)
@@ -68,7 +68,7 @@ def h_coefficient(process: str, value: float, rate: float) -> PowerLaw:
 
 
 def kalman_q(h0: float, h_minus2: float) -> KalmanQ:
-    """(q1, q2) of the two-state clock model from h_0 and h_-2: q1 = h_0 / 2 (s), q2 = 2 pi**2 h_-2 (1/s).
+    """(q1, q2) of the two-state clock model from ``h_0`` and ``h_-2``: q1 = ``h_0`` / 2 (s), q2 = 2 pi**2 ``h_-2`` (1/s).
 
     >>> q1, q2 = kalman_q(2e-22, 1e-30)
     >>> q1, round(q2 / 1e-30, 6)

@@ -6,7 +6,7 @@ described by a sum of independent power-law processes: white PM (QN), white FM (
 factors m = 1, 2, 4, ... by the generalized method of wavelet moments (:func:`avar.gmwm`), the
 sums are ranked by an AIC-type penalized objective (:func:`avar.select_model`, 2 per parameter),
 and the chosen one is refitted with a parametric bootstrap for its intervals. The processes'
-per-sample parameters convert exactly to the power-law coefficients h_alpha and to the
+per-sample parameters convert exactly to the power-law coefficients ``h_alpha`` and to the
 diffusion coefficients q1, q2 of the two-state Kalman clock model
 (:mod:`avar.fit.clock.coefficients`). The implied Allan deviation is checked against the
 record's OADEV and its chi-squared band at every level.
@@ -44,7 +44,7 @@ class ClockReport:
         One row per power law in the chosen model: ``Noise``, ``alpha``, ``h`` (S_y = h f**alpha,
         1/Hz at f = 1 Hz), ``Lower``, ``Upper`` (the ``confidence`` interval), ``Process``.
     kalman : pandas.DataFrame
-        ``q1`` (s, white FM: h_0 / 2), ``q2`` (1/s, random-walk FM: 2 pi**2 h_-2) and ``r``
+        ``q1`` (s, white FM: ``h_0`` / 2), ``q2`` (1/s, random-walk FM: 2 pi**2 ``h_-2``) and ``r``
         (s**2, white PM measurement noise sigma_x**2) with intervals; 0 where the model has no
         such term.
     fit : GmwmResult
@@ -104,7 +104,7 @@ def _frequency(x: Any, rate: float, data_type: str) -> np.ndarray:
 
 def clock_report(x: Any, rate: float = 1.0, data_type: str = "phase", *, confidence: float = 0.95, B: int = 100,
                  seed: Any = None, processes: Any = None) -> ClockReport:
-    """Power-law coefficients h_alpha and Kalman diffusion coefficients q of a clock, with intervals.
+    """Power-law coefficients ``h_alpha`` and Kalman diffusion coefficients q of a clock, with intervals.
 
     Parameters
     ----------

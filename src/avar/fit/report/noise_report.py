@@ -326,7 +326,8 @@ def noise_report(
         kinds.append(kind)
         data_units.append(unit)
         rows += channel_rows(channel, kind, unit, fit, av.freq, significance)
-        rows.append(minimum_row(channel, kind, unit, av.levels, av.adev, lower, upper))
+        rows.append(minimum_row(channel, kind, unit, av.levels, av.adev, lower, upper,
+                                duration=av.n_samples / av.freq))
         notes = [departure] if departure else []
         if values is not None:
             notes += data_warnings(channel, kind, values, av.freq, len(av), robust=bool(robust))

@@ -132,19 +132,40 @@ def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFi
     return rows
 
 
+#: The AD minimum is read where the level averages at least this many non-overlapping clusters
+#: (tau <= duration / 8): a minimum from a handful of clusters is mostly chance.
+MIN_CLUSTERS = 8
+
+
 def minimum_row(channel: str, kind: str | None, unit: str | None, tau: np.ndarray, adev: np.ndarray,
-                lower: np.ndarray, upper: np.ndarray) -> dict[str, Any]:
-    """The Allan-deviation minimum over the levels (the datasheets' in-run bias stability), with its band."""
-    at = int(np.nanargmin(adev))
+                lower: np.ndarray, upper: np.ndarray, duration: float | None = None) -> dict[str, Any]:
+    """The Allan-deviation minimum (the datasheets' in-run bias stability), with its band.
+
+    Taken over the well-sampled levels, tau <= ``duration`` / :data:`MIN_CLUSTERS` (at least 8
+    non-overlapping clusters; ``duration`` = N / rate, s); when the minimum over every level
+    lies beyond, the row's Note gives it with its tau.
+    """
+    tau = np.asarray(tau, dtype=np.float64)
+    adev = np.asarray(adev, dtype=np.float64)
+    well = np.ones(tau.size, dtype=bool) if duration is None else tau <= duration / MIN_CLUSTERS
+    if not well.any():
+        well[0] = True
+    at = int(np.flatnonzero(well)[np.nanargmin(adev[well])])
+    overall = int(np.nanargmin(adev))
     si = tuple(to_si(float(v[at]), kind, unit) for v in (adev, lower, upper))
     custom, custom_unit = (pd.NA,) * 3, ""
     if kind == GYRO:
         custom, custom_unit = tuple(v / DEG * 3600.0 for v in si), "deg/h"
     elif kind == ACCEL:
         custom, custom_unit = tuple(v / (G0 * 1e-6) for v in si), "ug"
+    note = "the empirical minimum over the levels with at least 8 clusters, with its chi-squared band"
+    if overall != at:
+        lowest = to_si(float(adev[overall]), kind, unit)
+        shown = lowest / DEG * 3600.0 if kind == GYRO else lowest / (G0 * 1e-6) if kind == ACCEL else lowest
+        note += (f"; the global minimum {shown:.4g} {custom_unit or _si_unit(kind, unit, unit or 'u')} at "
+                 f"tau = {tau[overall]:g} s averages fewer than 8 clusters")
     return _row(channel, kind, "AD minimum (in-run bias stability)", "MIN", "measured",
-                _si_unit(kind, unit, unit or "u"), si, custom_unit, custom, tau=float(tau[at]),
-                note="the empirical minimum over the levels, with its chi-squared band")
+                _si_unit(kind, unit, unit or "u"), si, custom_unit, custom, tau=float(tau[at]), note=note)
 
 
 def _si_unit(kind: str | None, unit: str | None, fallback: str) -> str:
