@@ -105,7 +105,7 @@ def plot_report(
     >>> x = (avar.WN(sigma2=1e-6) + avar.FN(b2=1e-9)).simulate(50_000, seed=1)
     >>> fig = avar.noise_report(x, gyro_units="rad/s", rate=100.0).plot()
     >>> [line.get_label() for line in fig.axes[0].lines][1:]
-    ['N = 0.342 deg/sqrt(h)', 'B = 6.38 deg/h (IEEE 952: AD = 0.664 B)', 'AD minimum 2.51 deg/h at 164 s', 'Implied AD (sum of variances)']
+    ['N = 0.342 deg/sqrt(h)', 'B = 6.38 deg/h (IEEE 952: AD = 0.664 B)', 'AD minimum 3.66 deg/h at 41 s', 'Implied AD (sum of variances)']
     """
     from avar.fit.report.result import NoiseReport
 
