@@ -30,7 +30,7 @@ usable here: its O(1 / n) leakage from the differenced white noise (about
 2 sigma2 / n) exceeds gamma2 at the few frequencies where the random walk lives.
 
 Also printed, all asymptotic at the truth from the exact covariance Sigma of
-the maximal-overlap AV estimates (:mod:`avar.fit.gmwm.covariance`), J = d nu / d theta:
+the maximal-overlap AV estimates (:mod:`avar.fit.covariance.exact`), J = d nu / d theta:
 
 * ``gmwm diag (pred)``: the sandwich (J'WJ)^-1 J'W Sigma W J (J'WJ)^-1 of the
   default weights W = diag(edf_j / (2 nu_j^2)) on the octave grid;
@@ -66,8 +66,8 @@ import pandas as pd
 from gmwm_vs_avlr import AVLR_PARAMETERS, SCENARIOS, N
 
 import avar
+from avar.fit.covariance.exact import exact_covariance
 from avar.fit.gmwm import octave_factors
-from avar.fit.gmwm.covariance import mo_av_covariance
 from avar.models import AR1, DR, QN, RW, WN
 
 
@@ -145,7 +145,7 @@ def av_jacobian(model, factors: np.ndarray) -> np.ndarray:
 
 def gmwm_asymptotic(model, n: int, factors: np.ndarray, diagonal: bool) -> np.ndarray:
     """Asymptotic relative SD of the GMWM at the truth: default diagonal weights or efficient ones."""
-    sigma = mo_av_covariance(model, n, factors)
+    sigma = exact_covariance(model, n, factors)
     jac = av_jacobian(model, factors)
     if diagonal:
         nu = model.theoretical_av(factors)

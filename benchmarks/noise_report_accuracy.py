@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 import avar
-from avar.fit.noise_fit import FLICKER_FACTOR
+from avar.models.flicker import FLICKER_AV_FACTOR
 
 FREQ = 200.0
 N_SAMPLES = int(2 * 3600 * FREQ)
@@ -62,7 +62,7 @@ def ros_rules(av) -> dict[str, float]:
     walk = tau >= 1000.0
     return {
         "ARW": _fixed_slope_line(tau[white], adev[white], -0.5, 1.0),
-        "BI": float(adev.min()) / math.sqrt(FLICKER_FACTOR),
+        "BI": float(adev.min()) / math.sqrt(FLICKER_AV_FACTOR),
         "RRW": _fixed_slope_line(tau[walk], adev[walk], 0.5, 3.0),
     }
 

@@ -20,6 +20,7 @@ import numpy as np
 if TYPE_CHECKING:  # pandas loads only for frames and Series
     import pandas as pd
 
+from avar._escape import terminal
 from avar._validation import (
     EXACT_INTEGER_LIMIT,
     as_array,
@@ -387,7 +388,7 @@ class IMU:
         counts = ", ".join(
             f"{self.sensor_types.count(kind)} {kind}" for kind in SENSOR_TYPES if kind in self.sensor_types
         )
-        return f"{self.name}: {len(self.channels)} channels ({counts}), N = {self.n}, freq = {self.freq:g} Hz"
+        return f"{terminal(self.name)}: {len(self.channels)} channels ({counts}), N = {self.n}, freq = {self.freq:g} Hz"
 
     def __repr__(self) -> str:
         return f"<IMU {self.describe()}>"

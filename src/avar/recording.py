@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from avar._escape import terminal
 from avar._frozen import frozen_mapping
 from avar._vocabulary import check_rate, renamed
 
@@ -166,7 +167,7 @@ class Recording:
         return note
 
     def describe(self) -> str:
-        where = f"{self.source}: " if self.source else ""
+        where = f"{terminal(self.source)}: " if self.source else ""  # a path: shown, never obeyed
         return f"{where}{len(self.columns)} column(s) x {self.n} samples {self.rate_note()}"
 
     def __repr__(self) -> str:

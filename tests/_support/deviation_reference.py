@@ -55,6 +55,13 @@ def terms(estimator: str, x: list, m: int, valid) -> list:
             parts = [c * x[i] for i, c in _mdev_points(j, m)]
             out.append(sum(parts[1:], start=parts[0]) if valid([i for i, _ in _mdev_points(j, m)]) else None)
         return out
+    if estimator in ("mhdev", "htdev"):
+        out = []
+        for j in range(n - 4 * m + 1):
+            points = _mhdev_points(j, m)
+            parts = [c * x[i] for i, c in points]
+            out.append(sum(parts[1:], start=parts[0]) if valid([i for i, _ in points]) else None)
+        return out
     # totdev: reflection at both ends, terms centred on points 1..N-2 (0-based)
     last = n - 1
 
@@ -83,20 +90,36 @@ def _mdev_points(j: int, m: int) -> list:
     return [(p, weights.get(p, 0)) for p in range(j, j + 3 * m)]
 
 
+def _mhdev_points(j: int, m: int) -> list:
+    """Points and coefficients of MHDEV's term j: sum_{i=j}^{j+m-1} (x_{i+3m} - 3 x_{i+2m} + 3 x_{i+m} - x_i)."""
+    weights: dict[int, int] = {}
+    for i in range(j, j + m):
+        for p, c in ((i, -1), (i + m, 3), (i + 2 * m, -3), (i + 3 * m, 1)):
+            weights[p] = weights.get(p, 0) + c
+    return [(p, weights.get(p, 0)) for p in range(j, j + 4 * m)]
+
+
+#: Denominator constant K of sigma^2 = sum / (K tau^2 n) (the modified ones also / m^2), and the time
+#: deviations' tau^2 / factor.
+_K = {"hdev": 6, "ohdev": 6, "mhdev": 6, "htdev": 6}
+_MODIFIED = ("mdev", "tdev", "mhdev", "htdev")
+_TIME = {"tdev": Fraction(3), "htdev": Fraction(10, 3)}
+
+
 def exact_variance(estimator: str, data, m: int, data_type: str = "phase", rate: float = 1.0):
     """(variance, number of terms) in exact arithmetic; terms touching a NaN are skipped."""
     x, valid = phase_of(data, data_type)
     values = [t for t in terms(estimator, x, m, valid) if t is not None]
-    k = 6 if estimator in ("hdev", "ohdev") else 2
+    k = _K.get(estimator, 2)
     tau = Fraction(m) / Fraction(rate)
     tau0 = 1 / Fraction(rate)
     phase_unit = tau0 * tau0 if data_type == "freq" else 1
     total = sum((t * t for t in values), start=Fraction(0)) * phase_unit
     variance = total / (k * tau * tau * len(values))
-    if estimator in ("mdev", "tdev"):
+    if estimator in _MODIFIED:
         variance /= m * m
-    if estimator == "tdev":
-        variance *= tau * tau / 3
+    if estimator in _TIME:
+        variance *= tau * tau / _TIME[estimator]
     return float(variance), len(values)
 
 
@@ -106,13 +129,13 @@ def fsum_variance(estimator: str, data, m: int, data_type: str = "phase", rate: 
     if data_type == "freq":
         x = [v / rate for v in x]
     values = [t for t in terms(estimator, x, m, valid) if t is not None]
-    k = 6 if estimator in ("hdev", "ohdev") else 2
+    k = _K.get(estimator, 2)
     tau = m / rate
     variance = math.fsum(t * t for t in values) / (k * tau * tau * len(values))
-    if estimator in ("mdev", "tdev"):
+    if estimator in _MODIFIED:
         variance /= m * m
-    if estimator == "tdev":
-        variance *= tau * tau / 3
+    if estimator in _TIME:
+        variance *= tau * tau / float(_TIME[estimator])
     return variance, len(values)
 
 

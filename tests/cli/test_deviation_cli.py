@@ -72,6 +72,22 @@ def test_csv_and_figure_outputs(capsys, phase_file, tmp_path):
     assert code == 2 and "exists" in err
 
 
+def test_the_modified_hadamard_statistics_print_from_the_registry(capsys, phase_file):
+    path, x = phase_file
+    code, out, err = cli(capsys, "deviation", path, "--stat", "mhdev", "--stat", "htdev", "--stat", "mhtotdev",
+                         "--data-type", "phase")
+    assert code == 0, err
+    for block, name in zip(out.strip().split("\n\n"), ("mhdev", "htdev", "mhtotdev")):
+        lines = block.splitlines()
+        assert lines[0].startswith(f"clock.csv [x]: {name.upper()} (")
+        expected = getattr(avar, name)(x, rate=2.0, data_type="phase")
+        rows = [line.split() for line in lines[2:]]
+        assert [int(r[0]) for r in rows] == expected.averaging_factors.tolist() and int(rows[-1][0]) == 128  # <= 600 / 4
+        assert [int(r[2]) for r in rows] == expected.n.tolist()
+        np.testing.assert_allclose([float(r[5]) for r in rows], expected.deviation, rtol=1e-4)
+        np.testing.assert_allclose([float(r[6]) for r in rows], expected.uci, rtol=1e-4)
+
+
 def test_every_registered_statistic_is_a_public_function(capsys, phase_file):
     path, _ = phase_file
     for name in DEVIATION_STATISTICS:

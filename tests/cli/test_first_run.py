@@ -50,7 +50,8 @@ def test_cold_cache_says_it_once_and_warm_cache_never(tmp_path):
     x = np.random.default_rng(4).standard_normal(200)
     log.write_text("time,x\n" + "".join(f"{i / 10},{v!r}\n" for i, v in enumerate(x.tolist())))
     cache = tmp_path / "numba-cache"
-    environment = _environment(NUMBA_CACHE_DIR=str(cache))
+    # the compiled kernels (a short log's first call otherwise takes their NumPy twins: nothing to compile)
+    environment = _environment(NUMBA_CACHE_DIR=str(cache), AVAR_KERNEL_PATH="compiled")
     command = [sys.executable, "-m", "avar", "compute", str(log), "--output", "-"]
     probe = [sys.executable, "-c", "from avar._kernels.runtime.cache import cached_for_this_machine as c; "
              "from avar._kernels.allan.small import small_allan_variance as k; print(c(k))"]

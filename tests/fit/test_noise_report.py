@@ -10,9 +10,9 @@ import pandas as pd
 import pytest
 
 import avar
-from avar.fit.noise_fit import FLICKER_FACTOR, fit_noise_terms, term_regressors
-from avar.fit.report.sensor_terms import FLICKER_AV_FACTOR
+from avar.fit.noise_fit import fit_noise_terms, term_regressors
 from avar.models import FN, QN, RW, WN
+from avar.models.flicker import FLICKER_AV_FACTOR
 
 FREQ = 100.0
 N_SAMPLES = 360_000  # one hour
@@ -129,7 +129,7 @@ def test_the_joint_fit_recovers_an_exact_curve():
     for term, value in truth.items():
         assert fit.squared[term] == pytest.approx(value, rel=1e-8, abs=1e-20)
     assert fit.present == {"QN": False, "WN": True, "FN": True, "RW": True, "DR": False}
-    assert FLICKER_FACTOR == pytest.approx(2 * math.log(2) / math.pi)
+    assert FLICKER_AV_FACTOR == pytest.approx(2 * math.log(2) / math.pi)
     np.testing.assert_allclose(fit.model_av(tau), av, rtol=1e-8)
 
 

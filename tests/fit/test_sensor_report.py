@@ -16,9 +16,9 @@ import avar
 from avar.fit.gmwm import octave_factors
 from avar.fit.report.checks import data_warnings, fit_check, unit_warnings
 from avar.fit.report.sensor_fit import fit_sensor_model, term_bound
-from avar.fit.report.sensor_terms import basis, flicker_unit_av
+from avar.fit.terms import basis
 from avar.models import AR1, SIN, WN
-from avar.models.flicker import av_fn
+from avar.models.flicker import av_fn, flicker_unit_av
 
 FREQ = 200.0
 

@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 
 import avar
+from avar.stability.shared.registry import CLASSIC as CLASSIC_STATISTICS
 from avar.stability.shared.registry import DEVIATION_STATISTICS
 from tests._support.cli_runner import cli
 
@@ -107,8 +108,8 @@ def test_two_time_columns_with_different_rates_are_a_conflict(tmp_path, capsys):
 
 # --------------------------------------------------------------------------- time indexes
 DEVIATIONS = [getattr(avar, name) for name in DEVIATION_STATISTICS]
-#: The seven that rescale data near the float64 limits themselves (the others refuse tiny data).
-CLASSIC = ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")
+#: The classic family rescales data near the float64 limits itself (the others refuse tiny data).
+CLASSIC = CLASSIC_STATISTICS
 
 
 @pytest.mark.parametrize("estimator", DEVIATIONS, ids=lambda f: f.__name__)

@@ -255,7 +255,7 @@ def test_npz_archives_of_named_columns_or_an_array_and_its_names(tmp_path):
         ("rows.npz", dict(t=np.ones(8), data=np.ones((9, 2))), r"holds t float64\[8\], data float64\[9, 2\]"),
         ("ragged.npz", dict(a=np.ones(9), b=np.ones(8)), r"equal-length 1-D arrays"),
         ("badnames.npz", dict(data=np.ones((9, 2)), columns=np.array(["x"])), r"1 column name\(s\) \['x'\] for 2"),
-        ("objects.npz", dict(data=np.array([{"a": 1}], dtype=object)), r"not a readable .npz archive"),
+        ("objects.npz", dict(data=np.array([{"a": 1}], dtype=object)), r"member .data.npy. holds Python objects"),
     ]:
         np.savez(tmp_path / name, **arrays)
         with pytest.raises(InputFileError, match=message):

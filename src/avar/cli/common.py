@@ -8,6 +8,7 @@ import time
 
 import pandas as pd
 
+from avar._escape import terminal as printable
 from avar._validation import check_freq, short_repr
 from avar._vocabulary import REMOVED_IN, complement
 from avar.fit.report.noise_terms import ACCEL, GYRO, UNIT_SPELLINGS, check_unit
@@ -16,7 +17,7 @@ from avar.io.read import InputFileError
 __all__ = ["FLOAT_FORMAT", "InputFileError", "Progress", "UsageError", "accel_unit", "add_confidence_arguments",
            "add_rate_arguments", "add_unit_arguments", "confidence_alpha", "confidence_level", "display",
            "format_table", "gyro_unit", "parse_scales", "printable", "replicates", "resolve_aliases", "seed_number",
-           "unit_label"]
+           "unit_label", "variables_note"]
 
 FLOAT_FORMAT = "{:.6g}".format
 
@@ -30,7 +31,7 @@ class Progress:
 
     def __call__(self, message: str) -> None:
         if self.enabled:
-            print(f"[{time.perf_counter() - self.started:6.1f} s] {message}", file=sys.stderr, flush=True)
+            print(f"[{time.perf_counter() - self.started:6.1f} s] {printable(message)}", file=sys.stderr, flush=True)
 
 
 #: Most scale numbers a comma-separated ``--wn`` list may expand to (a single range stays lazy).
@@ -73,18 +74,21 @@ def parse_scales(text: str) -> range | list[int]:
     return [scale for piece in pieces for scale in piece]
 
 
-def printable(text: object) -> str:
-    r"""``text`` with control and escape characters written as escapes, safe to print on a terminal.
+#: Files whose variables (keys) become the columns: the note says which became time and which data.
+ARCHIVE_SUFFIXES = (".mat", ".npz")
 
-    Names read from a file (a header cell holding ``\x1b[2J``) are shown, never obeyed.
 
-    >>> printable("gx\x1b[31m")
-    'gx\\x1b[31m'
-    """
-    text = str(text)
-    if text.isprintable():
-        return text
-    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
+def variables_note(path: str, data) -> str | None:
+    """``log.mat: time from variable 'time'; data from 'gx', 'gy'`` for a ``.mat``/``.npz`` file of several
+    variables (None for other files), so that the choice the reader made is never silent."""
+    if not str(path).lower().endswith(ARCHIVE_SUFFIXES) or not hasattr(data, "columns"):
+        return None
+    names = list(data.columns)
+    if len(names) + (data.time_column is not None) < 2:
+        return None
+    time = f"time from variable {data.time_column!r}" if data.time_column else "no time variable"
+    shown = ", ".join(repr(name) for name in names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    return f"{path}: {time}; data from {shown}"
 
 
 #: Longest name or text cell shown in a printed table (the CSV output keeps it whole).

@@ -32,7 +32,7 @@ from avar.cli.compute_many import (
     summary_of,
 )
 from avar.cli.outputs import csv_text, plan_outputs, report
-from avar.io.progress import PROGRESS_VALUES
+from avar.io.streams import PROGRESS_VALUES
 
 __all__ = ["ReadOptions", "add_input_arguments", "add_parser", "allan_of", "compute_from_args", "figure_of", "load",
            "read_from_args", "run", "summary_of"]
@@ -95,7 +95,7 @@ def compute_from_args(args: argparse.Namespace, progress: Progress):
         from tqdm import tqdm
 
         names = tqdm(names, desc="computing", unit="column", file=sys.stderr, leave=False)
-    return allan_of(data, args.type, args.taus, names)
+    return allan_of(data, args.type, args.taus, names, nan_policy=getattr(args, "nan_policy", "raise"))
 
 
 @contextmanager
@@ -158,6 +158,13 @@ def add_reading_arguments(parser: argparse.ArgumentParser, rate_default: str = "
     parser.add_argument("--gaps", choices=["error", "ignore"], default="error", help=GAPS_HELP)
 
 
+def add_nan_policy_argument(parser: argparse.ArgumentParser, what: str) -> None:
+    """``--nan-policy raise|omit``: NaN and empty cells refused, or read as gaps the statistics skip."""
+    parser.add_argument("--nan-policy", choices=["raise", "omit"], default="raise",
+                        help=f"NaN values and empty cells (gaps) in the data: refuse (raise, the default), or read "
+                             f"them as gaps and skip the {what} that touch them (omit)")
+
+
 def add_output_arguments(parser: argparse.ArgumentParser, table: str = OUTPUT_HELP) -> None:
     parser.add_argument("--output", metavar="CSV", help=table)
     parser.add_argument("--plot", metavar="PNG", help=PLOT_HELP)
@@ -195,5 +202,6 @@ def add_parser(commands) -> None:
                     "Scale, Time (s), AVar, ADev, Lower CI, Upper CI; a figure; many files at once, optionally on "
                     "a dask cluster.")
     add_input_arguments(compute, many=True)
+    add_nan_policy_argument(compute, "differences of cluster means")
     add_cluster_arguments(compute)
     compute.set_defaults(handler=run)

@@ -27,7 +27,16 @@ from typing import Any
 
 import pandas as pd
 
-from avar.cli.common import InputFileError, Progress, UsageError, format_table, printable, unit_label
+from avar._escape import figure_text
+from avar.cli.common import (
+    InputFileError,
+    Progress,
+    UsageError,
+    format_table,
+    printable,
+    unit_label,
+    variables_note,
+)
 from avar.cli.outputs import csv_text, plan_outputs, report
 
 __all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "check_bag_units", "compute_file",
@@ -89,6 +98,8 @@ class ReadOptions:
     accel_units: str | None = None
     #: How the rate was given on the command line (``--rate`` or its alias ``--freq``), for the notes.
     rate_option: str = "--rate"
+    #: NaN and empty cells: refused ("raise") or kept as gaps the Allan variance skips ("omit").
+    nan_policy: str = "raise"
 
     @classmethod
     def from_args(cls, args: argparse.Namespace) -> ReadOptions:
@@ -100,7 +111,7 @@ class ReadOptions:
         return cls(tuple(args.column or ()), args.rate, args.time_unit, args.gaps, args.topic,
                    tuple(args.gyro or ()), tuple(args.accel or ()), args.type, args.taus,
                    getattr(args, "gyro_units", None), getattr(args, "accel_units", None),
-                   getattr(args, "rate_option", "--rate"))
+                   getattr(args, "rate_option", "--rate"), getattr(args, "nan_policy", "raise"))
 
     @property
     def units(self) -> dict[str, str]:
@@ -122,13 +133,14 @@ def load(path: str, options: ReadOptions, progress: bool | None = None) -> tuple
         gaps=options.gaps,
         topic=options.topic,
         progress=progress,
+        nan_policy=options.nan_policy,
     )
     if isinstance(data, IMU):  # a bag: SI units by definition (check_bag_units refuses others)
         return data, [f"{path}: {data.describe()}"]
     note = data.describe().replace("(given)", f"({options.rate_option})")
     if data.time_column is None and options.rate is None:
         note += "; pass --rate for seconds"
-    notes = [note]
+    notes = [note, *filter(None, [variables_note(path, data)])]
     if data.gaps_ignored:
         notes.append(f"{path}: --gaps ignore: the samples are treated as contiguous across the gaps")
     if imu_columns:
@@ -168,15 +180,16 @@ def series_unit(args: argparse.Namespace, imu: bool) -> str | None:
     return gyro or accel
 
 
-def allan_of(data: Any, type: str, taus: str, names: Iterable[str] | None = None):
-    """The Allan variance of an IMU, or of every column of a Recording (a dict by column name)."""
+def allan_of(data: Any, type: str, taus: str, names: Iterable[str] | None = None, nan_policy: str = "raise"):
+    """The Allan variance of an IMU, or of every column of a Recording (a dict by column name; with
+    ``nan_policy="omit"`` the differences that touch a NaN are skipped)."""
     from avar.imu import IMU
     from avar.stability.allan.estimator import avar
 
     if isinstance(data, IMU):
         return avar(data, type=type, taus=taus)
     names = data.columns if names is None else names
-    return {name: avar(data.columns[name], type, data.rate, taus=taus) for name in names}
+    return {name: avar(data.columns[name], type, data.rate, taus=taus, nan_policy=nan_policy) for name in names}
 
 
 def summary_of(results) -> pd.DataFrame:
@@ -196,7 +209,7 @@ def figure_of(results, ylab: str | None = None):
     if isinstance(results, dict):
         if len(results) == 1:
             return next(iter(results.values())).plot(ylab=ylab)
-        return plot_compare(list(results.values()), labels=list(results), ylab=ylab)
+        return plot_compare(list(results.values()), labels=[figure_text(name) for name in results], ylab=ylab)
     return results.plot()
 
 
@@ -233,7 +246,7 @@ def compute_file(path: str, options: ReadOptions) -> tuple[dict[str, Any], tuple
     or in this process for a serial run.
     """
     data, notes = load(path, options, progress=False)
-    return pack(allan_of(data, options.type, options.taus)), tuple(notes)
+    return pack(allan_of(data, options.type, options.taus, nan_policy=options.nan_policy)), tuple(notes)
 
 
 # ----------------------------------------------------------------------------- the driver
@@ -299,7 +312,7 @@ def figure_of_files(labels: list[str], results: list[Any], ylab: str | None = No
         for name, av in channels.items():
             curves.append(av)
             names.append(label if len(channels) == 1 else f"{label}: {name}")
-    return plot_compare(curves, labels=names, ylab=ylab)
+    return plot_compare(curves, labels=[figure_text(name) for name in names], ylab=ylab)
 
 
 def _check_files(paths: list[str]) -> None:

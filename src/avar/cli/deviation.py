@@ -9,12 +9,14 @@ statistic needs no change here.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import pandas as pd
 
-from avar.cli.common import Progress, UsageError, add_confidence_arguments
-from avar.cli.compute import add_output_arguments, add_reading_arguments
+from avar._escape import figure_text
+from avar.cli.common import Progress, UsageError, add_confidence_arguments, printable, variables_note
+from avar.cli.compute import add_nan_policy_argument, add_output_arguments, add_reading_arguments
 from avar.cli.outputs import plan_outputs, report
 from avar.stability.shared.confidence import DEFAULT_CONFIDENCE
 from avar.stability.shared.registry import DEVIATION_STATISTICS
@@ -53,12 +55,16 @@ def _values(args: argparse.Namespace):
 
     if args.column and len(args.column) > 1:
         raise UsageError(f"deviation tables are of one column; --column is given {len(args.column)} times")
-    data = read(args.file, columns=args.column, rate=args.rate, time_unit=args.time_unit, gaps=args.gaps)
+    data = read(args.file, columns=args.column, rate=args.rate, time_unit=args.time_unit, gaps=args.gaps,
+                nan_policy=args.nan_policy)
     names = list(data.columns)
     if len(names) != 1:
         raise UsageError(f"{args.file} has {len(names)} data columns ({', '.join(names[:6])}); "
                          "choose one with --column NAME")
     rate = args.rate if args.rate is not None else data.rate
+    note = variables_note(args.file, data)
+    if note:
+        print(printable(note), file=sys.stderr)
     return names[0], data.columns[names[0]], float(rate)
 
 
@@ -74,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
         progress(f"computing {name}")
         results.append(function(values, rate=rate, data_type=args.data_type, taus=args.taus,
                                 confidence=args.confidence, nan_policy=args.nan_policy, alpha=args.noise))
-    source = f"{Path(args.file).name} [{column}]"
+    source = f"{Path(args.file).name} [{column}]"  # names from the user's file: escaped for each sink below
 
     def csv() -> str:
         frames = [table_of(r).assign(Stat=r.name)[["Stat", *TABLE_COLUMNS]] for r in results]
@@ -85,13 +91,13 @@ def run(args: argparse.Namespace) -> int:
 
         fig = None
         for k, result in enumerate(results):
-            fig = plot_deviation(result, colour=f"C{k}", main=f"{source}, {args.data_type} data",
+            fig = plot_deviation(result, colour=f"C{k}", main=f"{figure_text(source)}, {args.data_type} data",
                                  ylab="Deviation", ax=None if fig is None else fig.axes[0])
         return fig
 
     written = plan.write(csv=csv, figure=figure)
     progress("done")
-    report(written, "\n\n".join(format_run(r, source) for r in results))
+    report(written, "\n\n".join(format_run(r, printable(source)) for r in results))
     return 0
 
 
@@ -115,9 +121,7 @@ def add_parser(commands) -> None:
     parser.add_argument("--noise", type=int, choices=[2, 1, 0, -1, -2], metavar="ALPHA",
                         help="fix the power-law noise exponent alpha at every level, as Stable32 allows (2 white PM, "
                              "1 flicker PM, 0 white FM, -1 flicker FM, -2 random-walk FM); default: identified")
-    parser.add_argument("--nan-policy", choices=["raise", "omit"], default="raise",
-                        help="NaN (gaps) in the data: refuse (raise, the default), or skip the terms that touch "
-                             "them (omit)")
+    add_nan_policy_argument(parser, "terms")
     add_reading_arguments(parser)
     add_output_arguments(parser, "write the tables to this CSV file, with a Stat column ('-': stdout; default: "
                                  "none, the tables are printed)")

@@ -152,7 +152,7 @@ def _standard_streams() -> None:
 def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """A warning of any library as one line of ours on stderr: no source line, no file path."""
     text = str(message).strip().splitlines()
-    print(f"avar: warning: {cap_text(text[0] if text else category.__name__)}", file=sys.stderr, flush=True)
+    print(f"avar: warning: {printable(cap_text(text[0] if text else category.__name__))}", file=sys.stderr, flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:

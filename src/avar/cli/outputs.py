@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from avar._escape import terminal_lines
 from avar.cli.common import UsageError, display, printable
 
 __all__ = ["OutputPlan", "Written", "csv_text", "figure_formats", "plan_outputs", "rename_no_replace", "report",
@@ -377,7 +378,8 @@ def write_atomically(path: Path, data: bytes, force: bool = True) -> None:
 
 
 def report(written: Written, text: str) -> None:
-    """Print ``text`` (the table) and a line per written file, after the files are written.
+    """Print ``text`` (the table; control characters escaped, line breaks kept) and a line per
+    written file, after the files are written.
 
     With ``--output -`` stdout holds the CSV alone: ``text`` is left out and the
     file lines go to stderr.
@@ -388,7 +390,7 @@ def report(written: Written, text: str) -> None:
         for name in written.files:
             print(f"Wrote {printable(name)}", file=sys.stderr)
         return
-    print(text)
+    print(terminal_lines(text))  # names in it are escaped where formatted; this is the net for the rest
     for name in written.files:
         print(f"Wrote {printable(name)}")
     sys.stdout.flush()

@@ -19,6 +19,7 @@ from avar.cli.common import (
     add_confidence_arguments,
     add_unit_arguments,
     printable,
+    variables_note,
 )
 from avar.cli.compute import FILE_HELP, add_output_arguments, add_reading_arguments
 from avar.cli.compute_many import check_bag_units
@@ -44,7 +45,8 @@ def read_recording(args: argparse.Namespace):
     if data.time_column is None and args.rate is None:
         raise InputFileError(f"{args.file}: no time column to take the rate from; pass --rate (Hz)")
     # The rate, where it comes from and the timestamps' jitter, as `avar compute` says them.
-    notes = [data.describe().replace("(given)", f"({args.rate_option})")]
+    notes = [data.describe().replace("(given)", f"({args.rate_option})"),
+             *filter(None, [variables_note(args.file, data)])]
     if data.gaps_ignored:
         notes.append(f"{args.file}: --gaps ignore: the samples are treated as contiguous across the gaps")
     return data, notes, args.topic
@@ -78,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     progress(f"reading {args.file}")
     data, notes, topic = read_recording(args)
     for note in notes:
-        print(note, file=sys.stderr)
+        print(printable(note), file=sys.stderr)
     progress("fitting the noise terms")
     report = noise_report(data, gyro_units=args.gyro_units, accel_units=args.accel_units,
                           gyro=args.gyro, accel=args.accel, confidence=args.confidence, name=Path(args.file).name,

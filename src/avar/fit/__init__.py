@@ -4,6 +4,8 @@
 * :mod:`avar.fit.avlr`: :func:`avlr` for series and IMU sensor types alike;
 * :mod:`avar.fit.bootstrap`: its parametric bootstrap;
 * :mod:`avar.fit.results`: :class:`AvlrResult`, :class:`ImuAvlrResult`;
+* :mod:`avar.fit.terms`: a fitted model's terms, each a process class of :mod:`avar.models` with values;
+* :mod:`avar.fit.covariance`: the covariance of maximal-overlap Allan variance estimates under a model;
 * :mod:`avar.fit.noise_fit`: the joint weighted fit of the IEEE 952 terms;
 * :mod:`avar.fit.auto_scales`: where each process dominates (:func:`auto_scales`);
 * :mod:`avar.fit.report`: the IMU noise report, :func:`noise_report` (the noise model a real

@@ -28,7 +28,7 @@ The selections are 1-based scale numbers as everywhere in :func:`avar.avlr`
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -37,7 +37,7 @@ from avar.fit.noise_fit import TERM_SLOPES, TERMS, TermFit, fit_noise_terms
 from avar.stability.allan.estimator import avar as allan_variance
 from avar.stability.allan.results import AllanVariance
 
-__all__ = ["AutoScales", "auto_scales", "level_edf", "local_slopes"]
+__all__ = ["AutoScales", "auto_scales", "level_edf", "local_slopes", "LocalSlopes"]
 
 
 def level_edf(av: AllanVariance) -> np.ndarray:
@@ -45,7 +45,14 @@ def level_edf(av: AllanVariance) -> np.ndarray:
     return np.maximum(av.n / av.averaging_factors.astype(np.float64) - 1.0, 1.0)
 
 
-def local_slopes(tau: np.ndarray, adev: np.ndarray, errors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+class LocalSlopes(NamedTuple):
+    """The local log-log slope of the Allan deviation at every level and its standard error."""
+
+    slope: np.ndarray
+    se: np.ndarray
+
+
+def local_slopes(tau: np.ndarray, adev: np.ndarray, errors: np.ndarray) -> LocalSlopes:
     """Local log-log slope of the Allan deviation and its standard error at every level.
 
     >>> tau = 2.0 ** np.arange(5)
@@ -56,13 +63,13 @@ def local_slopes(tau: np.ndarray, adev: np.ndarray, errors: np.ndarray) -> tuple
     log_tau, log_ad = np.log(tau), np.log(adev)
     n = tau.size
     if n < 2:
-        return np.full(n, np.nan), np.full(n, np.inf)
+        return LocalSlopes(np.full(n, np.nan), np.full(n, np.inf))
     lower = np.r_[0, np.arange(n - 2), n - 2]
     upper = np.r_[1, np.arange(2, n), n - 1]
     span = log_tau[upper] - log_tau[lower]
     slope = (log_ad[upper] - log_ad[lower]) / span
     se = np.sqrt(errors[upper] ** 2 + errors[lower] ** 2) / span
-    return slope, se
+    return LocalSlopes(slope, se)
 
 
 @dataclass(frozen=True, eq=False)

@@ -7,7 +7,8 @@ coefficient::
     AV(tau) = 3 Q^2 / tau^2 + N^2 / tau + (2 ln 2 / pi) B^2 + K^2 tau / 3 + R^2 tau^2 / 2
 
 (quantization Q, white noise N, flicker / bias instability B, random walk K,
-ramp R; ``TERMS``). The squared coefficients are fitted at every level at
+ramp R; ``TERMS``, the power laws of :mod:`avar.models`: each class's
+``ieee_av`` and ``slope``). The squared coefficients are fitted at every level at
 once by non-negative least squares, weighted by the inverse variance of each
 level's estimate, Var AV(tau_j) = 2 model_j^2 / edf_j, iterated so that the
 weights use the fitted model rather than the noisy estimate (which would
@@ -34,34 +35,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["TERMS", "TERM_PROCESS", "term_regressors", "TermFit", "fit_noise_terms"]
+from avar.fit.terms import POWER_LAWS, process_class
 
-#: Terms in IEEE order: quantization, white noise, flicker, random walk, ramp.
-TERMS = ("QN", "WN", "FN", "RW", "DR")
+__all__ = ["TERMS", "TERM_SLOPES", "term_regressors", "TermFit", "fit_noise_terms"]
+
+#: Terms in IEEE order (by slope): quantization, white noise, flicker, random walk, ramp.
+TERMS = tuple(cls.name for cls in POWER_LAWS)
 #: Log-log slope of each term's Allan deviation.
-TERM_SLOPES = {"QN": -1.0, "WN": -0.5, "FN": 0.0, "RW": 0.5, "DR": 1.0}
-#: Process name of each term (the classes of :mod:`avar.models`).
-TERM_PROCESS = {"QN": "QN", "WN": "WN", "FN": "FN", "RW": "RW", "DR": "DR"}
-#: Flicker AV per unit B^2: 2 ln 2 / pi.
-FLICKER_FACTOR = 2.0 * math.log(2.0) / math.pi
+TERM_SLOPES = {cls.name: cls.slope for cls in POWER_LAWS}
 
 
 def term_regressors(tau: np.ndarray, terms: tuple[str, ...] = TERMS) -> np.ndarray:
-    """Columns of AV(tau) per unit squared coefficient: 3/tau^2, 1/tau, 2 ln 2/pi, tau/3, tau^2/2.
+    """Columns of AV(tau) per unit squared coefficient: 3/tau^2, 1/tau, 2 ln 2/pi, tau/3, tau^2/2 (``ieee_av``).
 
     >>> term_regressors(np.array([1.0, 2.0]), ("WN", "RW"))
     array([[1.        , 0.33333333],
            [0.5       , 0.66666667]])
     """
     tau = np.asarray(tau, dtype=np.float64)
-    columns = {
-        "QN": 3.0 / tau**2,
-        "WN": 1.0 / tau,
-        "FN": np.full_like(tau, FLICKER_FACTOR),
-        "RW": tau / 3.0,
-        "DR": tau**2 / 2.0,
-    }
-    return np.column_stack([columns[t] for t in terms])
+    return np.column_stack([process_class(t).ieee_av(tau) for t in terms])
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from avar._escape import html_text
 from avar._frozen import frozen_array, frozen_frame, frozen_mapping, frozen_series
 from avar._vocabulary import deprecated_significance
 from avar.fit.slopes import format_scales, parameter_label
@@ -130,7 +131,7 @@ class AvlrResult:
         return f"<AvlrResult {values}{' with CI' if self.ci is not None else ''}>"
 
     def _repr_html_(self) -> str:
-        return f"<p>{self.describe()}<br>{self.av.describe()}</p>" + self.summary().to_html()
+        return f"<p>{html_text(self.describe())}<br>{html_text(self.av.describe())}</p>" + self.summary().to_html()
 
     def plot(self, **kwargs: Any):
         """Empirical and implied Allan deviation; see :func:`avar.plotting.plot_avlr`."""
@@ -297,7 +298,7 @@ class ImuAvlrResult:
         return f"<ImuAvlrResult {self.imu_av.sensor}; {'; '.join(parts)}>"
 
     def _repr_html_(self) -> str:
-        return f"<p>{self.describe()}</p>" + self.summary().to_html()
+        return f"<p>{html_text(self.describe())}</p>" + self.summary().to_html()
 
     def plot(self, **kwargs: Any):
         """Grid of empirical and implied Allan variances; see :func:`avar.plotting.plot_imu_avlr`."""

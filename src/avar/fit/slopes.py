@@ -16,7 +16,9 @@ DR          +1       1/sqrt(2) omega          u / s
 ==========  =======  ========  =============  ==========================
 
 These are the estimators of R ``avar`` 0.1.3 (``fit_avlr``), in the units of
-the tau axis: with ``freq`` in Hz, the usual continuous-time coefficients.
+the tau axis: with ``freq`` in Hz, the usual continuous-time coefficients. The
+table is the process classes' (:mod:`avar.models`: ``slope``, ``ad_coefficient``,
+``coefficient_label``), read here, not restated.
 :func:`avar.avlr` (one series, or one model per IMU sensor type pooled over
 its axes), its bootstrap and the IEEE 952 noise terms all use these pieces.
 """
@@ -34,16 +36,16 @@ from avar.models import DR, QN, RW, WN, NoiseModel, Process
 __all__ = ["PROCESSES", "SLOPES", "COEFFICIENTS", "check_scale_selections", "log_mean_estimate", "fit_slopes",
            "implied_allan_deviation", "per_sample_process", "per_sample_model", "parameter_label", "format_scales"]
 
-#: Processes in R's order (the order of estimates and of the fitted model).
-PROCESSES = ("WN", "QN", "RW", "DR")
-#: Per-sample process classes.
-PROCESS_CLASSES = {"WN": WN, "QN": QN, "RW": RW, "DR": DR}
+#: Per-sample process classes, in R's order (the order of estimates and of the fitted model).
+PROCESS_CLASSES = {cls.name: cls for cls in (WN, QN, RW, DR)}
+#: Processes in R's order.
+PROCESSES = tuple(PROCESS_CLASSES)
 #: Log-log slope b of AD(tau) = c theta tau**b.
-SLOPES = {"WN": -0.5, "QN": -1.0, "RW": 0.5, "DR": 1.0}
+SLOPES = {name: cls.slope for name, cls in PROCESS_CLASSES.items()}
 #: Coefficient c of AD(tau) = c theta tau**b.
-COEFFICIENTS = {"WN": 1.0, "QN": np.sqrt(3.0), "RW": 1.0 / np.sqrt(3.0), "DR": 1.0 / np.sqrt(2.0)}
+COEFFICIENTS = {name: cls.ad_coefficient for name, cls in PROCESS_CLASSES.items()}
 #: Parameter symbol and unit (u: data unit, s: unit of tau).
-PARAMETER_LABELS = {"WN": "sigma [u s^1/2]", "QN": "Q [u s]", "RW": "gamma [u s^-1/2]", "DR": "omega [u s^-1]"}
+PARAMETER_LABELS = {name: cls.coefficient_label for name, cls in PROCESS_CLASSES.items()}
 
 
 def parameter_label(process: str, unit: str | None = None) -> str:

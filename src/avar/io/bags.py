@@ -31,7 +31,7 @@ from avar._vocabulary import check_rate, renamed
 from avar.imu import IMU
 from avar.io.bag_decode import decode_imu
 from avar.io.bag_storage import Db3Bag, McapBag, Ros1Bag, Untrusted
-from avar.io.progress import progress_enabled
+from avar.io.streams import progress_enabled
 from avar.io.timecols import rate_of
 
 IMU_TYPE = "sensor_msgs/msg/Imu"

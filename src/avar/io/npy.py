@@ -12,10 +12,14 @@ columns=names)``). Anything else is an error that lists what the archive holds.
 
 from __future__ import annotations
 
+import math
 import zipfile
 from pathlib import Path
 
 import numpy as np
+
+from avar.io.streams import check_memory
+from avar.io.timecols import time_columns
 
 
 def read_npy(path: Path) -> dict[str, np.ndarray]:
@@ -67,12 +71,56 @@ def columns_of_array(array: np.ndarray, path: Path, names: np.ndarray | None = N
     return columns
 
 
+def _declared_arrays(path: Path) -> dict[str, tuple[tuple[int, ...], np.dtype]]:
+    """The shape and dtype every member of a ``.npz`` archive declares, read from the .npy headers
+    alone (nothing is allocated); a member that is not a ``.npy`` array is an error naming it."""
+    declared = {}
+    with zipfile.ZipFile(path) as archive:
+        for info in archive.infolist():
+            if info.is_dir():
+                continue
+            if not info.filename.endswith(".npy"):
+                raise ValueError(f"{path}: member {info.filename!r} of the .npz archive is not a .npy array; a .npz "
+                                 "archive holds .npy arrays only (numpy.savez)")
+            try:
+                with archive.open(info) as member:
+                    version = np.lib.format.read_magic(member)
+                    read_header = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                                   else np.lib.format.read_array_header_2_0)
+                    shape, _, dtype = read_header(member)
+            except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+                raise ValueError(f"{path}: member {info.filename!r} is not a readable .npy array "
+                                 f"({str(error).splitlines()[0][:200]})") from None
+            if dtype.hasobject:
+                raise ValueError(f"{path}: member {info.filename!r} holds Python objects ({dtype}), not numbers")
+            declared[info.filename[: -len(".npy")]] = (shape, dtype)
+    return declared
+
+
 def read_npz(path: Path) -> dict[str, np.ndarray]:
-    """The columns of a ``.npz`` archive (see the module's notes), by name."""
+    """The columns of a ``.npz`` archive (see the module's notes), by name.
+
+    The shapes the members declare are checked against the memory a reader may allocate
+    (:func:`avar.io.streams.check_memory`) before any member is decompressed."""
+    try:
+        declared = _declared_arrays(path)
+    except (OSError, EOFError, zipfile.BadZipFile) as error:
+        raise ValueError(f"{path}: not a readable .npz archive ({error})") from None
+    sizes = {key: math.prod(shape) * dtype.itemsize for key, (shape, dtype) in declared.items()}
+    if sizes:
+        largest = max(sizes, key=sizes.get)
+        shape, dtype = declared[largest]
+        check_memory(path, sum(sizes.values()), f"its arrays (the largest, {largest!r}, a {shape} {dtype} array)")
     try:
         with np.load(path, allow_pickle=False) as archive:
-            arrays = {key: archive[key] for key in archive.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+            arrays = {}
+            for key in archive.files:
+                try:
+                    arrays[key] = archive[key]
+                except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+                    raise ValueError(f"{path}: member {key + '.npy'!r} is not a readable .npy array "
+                                     f"({str(error).splitlines()[0][:200]})") from None
+    except (OSError, EOFError, zipfile.BadZipFile) as error:
         raise ValueError(f"{path}: not a readable .npz archive ({error})") from None
     return columns_of_arrays(arrays, path, "a .npz archive")
 
@@ -91,6 +139,9 @@ def columns_of_arrays(arrays: dict[str, np.ndarray], path: Path, what: str) -> d
         main = tables[0]
     else:  # 1-D arrays only: a column each
         main = None
+    if text and main is not None and time_columns([main]) and numbers[main].ndim == 1:
+        raise ValueError(f"{path}: {what} holds the time vector {main!r} and the text {next(iter(text))!r}, but no "
+                         "data: text names the columns of a data matrix (time, data and names); give the data too")
     singles = {key: value for key, value in numbers.items() if key != main}
     rows = {value.shape[0] for value in singles.values() if value.ndim == 1}
     if main is not None and numbers[main].ndim >= 1:

@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from avar.io.streams import check_memory, format_bytes
+
 #: The first and last bytes of every Parquet file.
 MAGIC = b"PAR1"
 
@@ -23,10 +25,27 @@ def is_parquet(path: Path) -> bool:
         return handle.read(4) == MAGIC
 
 
+def _check_declared(path: Path) -> None:
+    """The sizes the file's metadata declare (uncompressed row groups; 8 bytes per value once read)
+    against the memory a reader may allocate, before anything is decompressed."""
+    import pyarrow
+    import pyarrow.parquet as pq
+
+    try:
+        meta = pq.read_metadata(path)
+    except (OSError, ValueError, pyarrow.ArrowException) as error:
+        raise ValueError(f"{path}: not a readable Parquet file ({str(error).splitlines()[0][:200]})") from None
+    declared = sum(meta.row_group(i).total_byte_size for i in range(meta.num_row_groups))
+    values = 8 * meta.num_rows * meta.num_columns
+    check_memory(path, declared + values, f"{meta.num_rows:,} rows x {meta.num_columns:,} column(s) "
+                                          f"({format_bytes(declared)} uncompressed)")
+
+
 def read_parquet(path: Path) -> dict[str, np.ndarray]:
     """The columns of a Parquet file, by name, as 1-D arrays (numbers, or datetime64 for times)."""
     if importlib.util.find_spec("pyarrow") is None:
         raise ValueError(f"{path}: reading Parquet needs pyarrow; pip install \"allanvar[parquet]\" (or pyarrow)")
+    _check_declared(path)
     try:
         frame = pd.read_parquet(path, engine="pyarrow")
     except (OSError, ValueError) as error:

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import errno
 import lzma
 import os
+import stat
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -18,8 +20,8 @@ from avar.imu import IMU
 from avar.io.matlab import read_mat
 from avar.io.npy import read_npy, read_npz
 from avar.io.parquet import is_parquet, read_parquet
-from avar.io.progress import CountingReader, progress_enabled
-from avar.io.text import Layout, clip, compression_of, numeric_column, open_bytes, read_columns
+from avar.io.streams import CountingReader, compression_of, format_bytes, memory_limit, progress_enabled
+from avar.io.text import Layout, clip, numeric_column, read_columns
 from avar.io.timecols import rate_of, time_columns
 from avar.recording import Recording
 
@@ -39,15 +41,26 @@ def check_path(path: Any) -> Path:
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name (str or Path), got {type(path).__name__}")
     path = Path(path)
-    if path.is_dir():
+    try:
+        info = path.stat()
+    except OSError as error:
+        if error.errno == errno.ELOOP:
+            raise InputFileError(f"{path}: a loop of symbolic links (each points, in the end, to itself)") from None
+        if error.errno in (errno.ENOENT, errno.ENOTDIR):
+            raise InputFileError(f"{path}: no such file") from None
+        raise InputFileError(f"{path}: cannot be read ({error.strerror})") from None
+    if stat.S_ISDIR(info.st_mode):
         if (path / "metadata.yaml").is_file():
             return path  # a ROS 2 bag directory
         raise InputFileError(f"{path}: is a directory, not a file")
-    if not path.exists():
-        raise InputFileError(f"{path}: no such file")
-    if not path.is_file():
+    if not stat.S_ISREG(info.st_mode):
         raise InputFileError(f"{path}: not a regular file")
     return path
+
+
+def _out_of_memory(source: Path) -> InputFileError:
+    limit, meaning = memory_limit()
+    return InputFileError(f"{source}: ran out of memory while reading it (at most {format_bytes(limit)}: {meaning})")
 
 
 def _text_columns(path: Path, progress: bool | None) -> tuple[dict[str, Any], Layout]:
@@ -58,9 +71,8 @@ def _text_columns(path: Path, progress: bool | None) -> tuple[dict[str, Any], La
         from tqdm import tqdm
 
         with path.open("rb") as raw, tqdm(total=size, desc=f"reading {path.name}", unit="B", unit_scale=True,
-                                          file=sys.stderr, leave=False) as bar, \
-                open_bytes(path, CountingReader(raw, bar)) as stream:  # counts the file's (compressed) bytes
-            table, layout = read_columns(path, stream=stream)
+                                          file=sys.stderr, leave=False) as bar:
+            table, layout = read_columns(path, raw=CountingReader(raw, bar))  # counts the file's (compressed) bytes
     return table, layout
 
 
@@ -126,6 +138,7 @@ def read(
     topic: str | None = None,
     progress: bool | None = None,
     freq: float | None = None,
+    nan_policy: str = "raise",
 ) -> Recording | IMU:
     """Read a log: a text table, a ``.npy`` array or ``.npz`` archive, a Parquet table, a MATLAB file, or a ROS bag.
 
@@ -162,6 +175,10 @@ def read(
     progress : bool, optional
         Show a progress bar on stderr (default: when it is a terminal and the input
         holds more than ~10^7 values).
+    nan_policy : {"raise", "omit"}
+        NaN values and empty cells of the data columns: an error naming the first
+        (``"raise"``), or kept as NaN (``"omit"``): gaps that ``avar.avar(...,
+        nan_policy="omit")`` and the deviations skip. Infinite values are always an error.
 
     Returns
     -------
@@ -174,7 +191,9 @@ def read(
     ------
     InputFileError (a ValueError)
         A missing file or a directory, malformed tables, cells that are not numbers
-        (with their row and line), unknown or time columns asked as data, gaps.
+        (with their row and line), unknown or time columns asked as data, gaps; an
+        input whose data would take more memory than this process has (or than
+        ``AVAR_MAX_INPUT_BYTES`` allows), said before anything is allocated.
 
     Examples
     --------
@@ -189,6 +208,9 @@ def read(
     >>> rec.rate_note()
     "at 200 Hz from time column 'time' (jitter ... rms)"
     """
+    if nan_policy not in ("raise", "omit"):
+        raise ValueError(f"nan_policy must be 'raise' (NaN and empty cells are an error) or 'omit' (kept as NaN, "
+                         f"gaps the statistics skip), got {nan_policy!r}")
     if gaps not in GAP_POLICIES:
         raise ValueError(f"gaps must be one of {GAP_POLICIES}, got {gaps!r}")
     if time_unit is not None and time_unit not in ("s", "ms", "us", "ns"):
@@ -217,6 +239,8 @@ def read(
             table, layout = reader(source), None
         except ValueError as error:
             raise InputFileError(str(error)) from None
+        except MemoryError:  # what no declared size foretold
+            raise _out_of_memory(source) from None
     else:
         try:
             table, layout = _text_columns(source, progress)
@@ -225,6 +249,8 @@ def read(
         except ValueError as error:
             text = str(error) if len(str(error)) <= 400 else f"{str(error)[:400]}... (message cut)"
             raise InputFileError(text if text.startswith(str(source)) else f"{source}: {text}") from None
+        except MemoryError:  # a line too long for the memory left, say
+            raise _out_of_memory(source) from None
         except (EOFError, OSError, lzma.LZMAError) as error:  # the decompressor's: truncated or corrupt
             module = compression_of(source)
             if module is None:
@@ -243,16 +269,19 @@ def read(
     data = {}
     for name in wanted:
         try:
-            values = numeric_column(table[name], name, layout, source) if layout else np.asarray(table[name])
+            values = (numeric_column(table[name], name, layout, source, gaps=nan_policy == "omit") if layout
+                      else np.asarray(table[name]))
         except ValueError as error:
             raise InputFileError(str(error)) from None
         except Exception as error:  # the bag library's own errors: a corrupt or unknown bag
             if not type(error).__module__.startswith("rosbags"):
                 raise
             raise InputFileError(f"{source}: not a readable ROS bag ({clip(str(error))})") from None
-        if layout is None and values.dtype.kind == "f" and not np.isfinite(values).all():
-            row = int(np.flatnonzero(~np.isfinite(values))[0])
-            raise InputFileError(f"{source}: column {name!r} has a NaN or infinite value in row {row + 1}")
+        bad = (np.isinf(values) if nan_policy == "omit" else ~np.isfinite(values)) if values.dtype.kind == "f" else None
+        if layout is None and bad is not None and bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise InputFileError(f"{source}: column {name!r} has a{'n' if nan_policy == 'omit' else ' NaN or'} "
+                                 f"infinite value in row {row + 1}")
         values = values.view()
         values.flags.writeable = False
         data[name] = values

@@ -10,7 +10,11 @@ numbers are parsed by pandas' C engine in one pass, never cell by cell in Python
 * decimal commas (``0,5``) when the separator is not a comma;
 * a trailing separator on every line adds no column;
 * a gzip, bzip2 or xz compressed file (``log.csv.gz``) is read as its text, found by its
-  first bytes, decompressed as it streams (never whole in memory).
+  first bytes, decompressed as it streams (never whole in memory);
+* blank and ``#`` comment lines before the data are counted, never kept (any number of them);
+  the parser reads up to the last line holding anything; a last line without a line end (a file
+  still being written) is left out with a warning, NUL bytes are an error naming their line, and
+  the columns' memory is checked before they are allocated (:mod:`avar.io.streams`).
 
 Integer columns stay int64, exact even beyond 2**53. Cells that are not numbers are
 reported with their row and line (clipped to a readable length).
@@ -18,26 +22,30 @@ reported with their row and line (clipped to a readable length).
 
 from __future__ import annotations
 
-import bz2
 import codecs
-import contextlib
 import csv
-import gzip
 import io
-import lzma
 import re
 import warnings
-from collections.abc import Iterator
 from pathlib import Path
-from typing import BinaryIO
+from typing import BinaryIO, NamedTuple
 
 import numpy as np
 import pandas as pd
 
+from avar.io.streams import (
+    MAX_LINE_CHARS,
+    Snapshot,
+    check_memory,
+    count_preamble,
+    line_too_long,
+    measure,
+    open_bytes,
+    open_text_bytes,
+)
+
 #: Characters sniffed for the layout (the header and first data line are always read whole).
 SNIFF_BYTES = 1 << 16
-#: Longest line of a text table (characters): a longer one is refused, never cut.
-MAX_LINE_CHARS = 1 << 28
 #: Longest excerpt of a cell or line quoted in a message.
 QUOTE_LIMIT = 200
 _NUMBER = re.compile(r"[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?|[-+]?(nan|inf|infinity)", re.I)
@@ -84,27 +92,6 @@ def _is_number(token: str) -> bool:
     return bool(_NUMBER.fullmatch(token.strip().strip('"')))
 
 
-#: First bytes of the compressed files read as their text.
-_COMPRESSED = ((b"\x1f\x8b", gzip), (b"BZh", bz2), (b"\xfd7zXZ\x00", lzma))
-
-
-def compression_of(path: Path):
-    """The module (gzip, bz2, lzma) that decompresses ``path``, by its first bytes, else None."""
-    with path.open("rb") as handle:
-        magic = handle.read(6)
-    return next((module for prefix, module in _COMPRESSED if magic.startswith(prefix)), None)
-
-
-@contextlib.contextmanager
-def open_bytes(path: Path, raw: BinaryIO | None = None) -> Iterator[BinaryIO]:
-    """The bytes of ``path`` (or of ``raw``, its opened file), decompressed if it is compressed."""
-    module = compression_of(path)
-    with contextlib.ExitStack() as stack:
-        if raw is None:
-            raw = stack.enter_context(path.open("rb"))
-        yield raw if module is None else stack.enter_context(module.open(raw, "rb"))
-
-
 def detect_encoding(path: Path) -> str:
     """The text encoding of ``path``: from its byte-order mark, or UTF-16/32 recognised without one
     by the zero bytes of ASCII text; else UTF-8 (a UTF-8 byte-order mark skipped)."""
@@ -132,36 +119,46 @@ def detect_encoding(path: Path) -> str:
     return "utf-8-sig"
 
 
-def _head(path: Path, encoding: str) -> list[str]:
-    """The first lines of the file: every comment line, the first two others whatever their
-    length (a 10,000-column header is read whole), then more up to :data:`SNIFF_BYTES`."""
+class Head(NamedTuple):
+    """The start of a text table, as :func:`sniff` reads it."""
+
+    skip: int  # blank and ``#`` comment lines before the first data line: counted, never kept
+    comment: str | None  # the last of those comment lines, without its ``#`` (a header candidate)
+    lines: list[str]  # the first data line and the lines after it, up to SNIFF_BYTES (two whatever their length)
+
+
+def _head(path: Path, encoding: str) -> Head:
+    """The first lines of the file: the blank and comment lines before the data counted (never kept),
+    the first two data lines whatever their length (a 10,000-column header is read whole), then more
+    up to :data:`SNIFF_BYTES`."""
     lines: list[str] = []
     total = content = 0
     with open_bytes(path) as raw, io.TextIOWrapper(raw, encoding=encoding, errors="replace", newline="") as handle:
-        while line := handle.readline(MAX_LINE_CHARS + 1):
+        skip, comment, rest = count_preamble(handle, path)
+        buffered = io.StringIO(rest, newline="")
+        while True:
+            line = buffered.readline() or handle.readline(MAX_LINE_CHARS + 1)
+            if line and not line.endswith(("\n", "\r")):
+                line += handle.readline(MAX_LINE_CHARS + 1)  # a line cut by the end of a block
+            if not line:
+                break
             if len(line) > MAX_LINE_CHARS and not line.endswith(("\n", "\r")):
-                raise ValueError(f"{path}: line {len(lines) + 1} is longer than {MAX_LINE_CHARS:,} characters; "
-                                 "a text table's lines must be shorter")
+                raise line_too_long(path, skip + len(lines) + 1)
             lines.append(line.rstrip("\r\n"))
             total += len(line)
             if line.strip() and not line.lstrip().startswith("#"):
                 content += 1
             if content >= 2 and total >= SNIFF_BYTES:
                 break
-    return lines
+    return Head(skip, comment, lines)
 
 
 def sniff(path: Path, encoding: str = "utf-8-sig") -> Layout:
     """The separator, decimal mark and header of a text table, from its first lines."""
-    lines = _head(path, encoding)
-    skip, comment = 0, None
-    while skip < len(lines) and (not lines[skip].strip() or lines[skip].lstrip().startswith("#")):
-        if lines[skip].strip():
-            comment = lines[skip].lstrip()[1:].strip()
-        skip += 1
-    if skip == len(lines):
-        raise ValueError("the file holds no data (only blank or # comment lines)")
-    first = lines[skip]
+    skip, comment, lines = _head(path, encoding)
+    if not lines:
+        raise ValueError(f"the file holds no data (only blank or # comment lines: {skip:,})")
+    first = lines[0]
     if ";" in first:
         separator = ";"
     elif "\t" in first:
@@ -170,7 +167,7 @@ def sniff(path: Path, encoding: str = "utf-8-sig") -> Layout:
         separator = ","
     else:
         separator = r"\s+"
-    data_lines = "\n".join(lines[skip:])
+    data_lines = "\n".join(lines)
     decimal = "," if separator != "," and _DECIMAL_COMMA.search(data_lines) else "."
     tokens = _split(first, separator)
     trailing = len(tokens) > 1 and tokens[-1] == "" and separator != r"\s+"
@@ -206,16 +203,6 @@ def _check_names(names: list[str], path: Path) -> list[str]:
 #: Rows parsed per chunk: the columns are filled chunk by chunk into arrays sized once, so the
 #: peak memory is the columns plus one chunk (pandas alone holds the table about three times).
 CHUNK_ROWS = 1 << 18
-_COUNT_BLOCK = 1 << 24
-
-
-def count_lines(path: Path) -> int:
-    """Newlines in the file (an upper bound of its rows, less one)."""
-    count = 0
-    with open_bytes(path) as handle:
-        while block := handle.read(_COUNT_BLOCK):
-            count += block.count(b"\n")
-    return count
 
 
 def _column_arrays(chunk: pd.DataFrame):
@@ -288,24 +275,35 @@ class _Columns:
         return {name: array[:last] for name, array in arrays.items()}
 
 
-def read_columns(path: Path, stream: io.BufferedReader | None = None) -> tuple[dict[str, np.ndarray], Layout]:
+def read_columns(path: Path, raw: BinaryIO | None = None) -> tuple[dict[str, np.ndarray], Layout]:
     """The table's columns as arrays (numbers where they parse, else text), and its layout.
 
-    ``stream`` (the opened file's bytes, decompressed, e.g. counted by a progress bar) is
-    read instead of ``path`` when given.
+    ``raw`` (the opened file, e.g. counted by a progress bar) is parsed instead of ``path`` when
+    given. The parser gets the text as UTF-8 from the first line after the comments on (the
+    preamble is skipped as bytes: pandas would hold a set of the lines it skips).
     """
     layout = sniff(path, detect_encoding(path))
     names = _check_names(layout.names, path)
     extra = "\0trailing separator"
-    columns = _Columns(count_lines(path) + 1 - layout.skip)
+    extent = measure(path, layout.encoding, layout.skip)
+    if extent.nul_line is not None:
+        raise ValueError(f"{path}: line {extent.nul_line:,} holds NUL bytes (\\0), not text: the end of a file cut "
+                         f"short (a crash while writing, a preallocated file); cut the file before line "
+                         f"{extent.nul_line:,}")
+    if extent.cut_line is not None and extent.cut_line >= layout.first_data_line:
+        warnings.warn(f"{path}: the last line (line {extent.cut_line:,}) has no line end, as in a file still being "
+                      f"written; read up to line {extent.cut_line - 1:,}, its last complete line", stacklevel=4)
+    rows = max(extent.lines + 1 - layout.skip, 1)
+    check_memory(path, 8 * rows * len(names), f"{rows:,} rows x {len(names):,} column(s)")
+    columns = _Columns(rows)
     try:
         with warnings.catch_warnings():
             # A column whose blocks parse to different types is object here; numeric_column then
             # parses it or names its first non-number, so pandas' DtypeWarning would only be noise.
             warnings.simplefilter("ignore", pd.errors.DtypeWarning)
-            with contextlib.ExitStack() as stack:
-                source = stream if stream is not None else stack.enter_context(open_bytes(path))
-                _read_chunks(source, layout, names, extra, columns, path)
+            with open_text_bytes(path, layout.encoding, raw) as source:
+                snapshot = io.BufferedReader(Snapshot(source, extent.start, extent.end), buffer_size=1 << 20)
+                _read_chunks(snapshot, layout, names, extra, columns, path)  # the bytes measure saw
     except pd.errors.EmptyDataError:
         raise ValueError(f"{path}: the file holds a header but no data") from None
     except pd.errors.ParserWarning:
@@ -327,10 +325,10 @@ def _read_chunks(source, layout: Layout, names: list[str], extra: str, columns: 
         decimal=layout.decimal,
         header=None,
         names=[*names, extra] if layout.trailing else names,
-        skiprows=layout.skip + (1 if layout.header_row else 0),
+        skiprows=1 if layout.header_row else 0,  # the source starts after the comment lines
         index_col=False,
         engine="c",
-        encoding=layout.encoding,
+        encoding="utf-8-sig" if layout.encoding == "utf-8-sig" else "utf-8",  # transcoded by open_text_bytes
         skip_blank_lines=False,  # a blank line inside the data is a missing sample, not nothing
         quotechar='"',
         chunksize=CHUNK_ROWS,
@@ -350,8 +348,9 @@ def _read_chunks(source, layout: Layout, names: list[str], extra: str, columns: 
             columns.add(chunk)
 
 
-def numeric_column(column: np.ndarray, name: str, layout: Layout, path: Path) -> np.ndarray:
-    """A column as float64 or int64 (exact), with the first cell that is not a number named."""
+def numeric_column(column: np.ndarray, name: str, layout: Layout, path: Path, gaps: bool = False) -> np.ndarray:
+    """A column as float64 or int64 (exact), with the first cell that is not a number named; ``gaps``:
+    NaN and empty cells are kept as NaN (``nan_policy="omit"``), else refused."""
     if column.dtype.kind in "iuf":
         values = column
     elif column.dtype.kind == "b":
@@ -373,11 +372,12 @@ def numeric_column(column: np.ndarray, name: str, layout: Layout, path: Path) ->
             )
         values = parsed.to_numpy(dtype=np.float64, na_value=np.nan)
     if values.dtype.kind == "f":
-        missing = ~np.isfinite(values)
+        missing = np.isinf(values) if gaps else ~np.isfinite(values)  # gaps: NaN and empty cells are kept
         if missing.any():
             row = int(np.flatnonzero(missing)[0])
             raise ValueError(
-                f"{path}: column {name!r} has {int(missing.sum())} missing or non-finite value(s); the first is in "
-                f"row {row + 1} (line {row + layout.first_data_line}); fill or cut them"
+                f"{path}: column {name!r} has {int(missing.sum())} {'infinite' if gaps else 'missing or non-finite'} "
+                f"value(s); the first is in row {row + 1} (line {row + layout.first_data_line}); fill or cut them"
+                + ("" if gaps else ", or read them as gaps (nan_policy='omit', --nan-policy omit)")
             )
     return values

@@ -43,6 +43,7 @@ IEEE Std 952-1997, Annex C (bias instability).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import ClassVar
@@ -50,12 +51,15 @@ from typing import ClassVar
 import numpy as np
 
 from avar._validation import check_freq, check_real
-from avar.models.processes import Process
+from avar.models.base import Process
 
-__all__ = ["FN", "FLICKER_AV_FACTOR", "flicker_increment_autocovariance", "flicker_structure_function", "av_fn"]
+__all__ = ["FN", "FLICKER_AV_FACTOR", "flicker_increment_autocovariance", "flicker_structure_function", "av_fn",
+           "flicker_unit_av"]
 
 #: AV plateau of flicker per unit b2: 2 ln 2 / pi (AD = 0.664 B).
 FLICKER_AV_FACTOR = 2.0 * math.log(2.0) / math.pi
+#: Largest factor at which :func:`flicker_unit_av` sums the flicker AV exactly; beyond, its expansion in 1 / m^2.
+FLICKER_EXACT = 4096
 
 
 def flicker_increment_autocovariance(b2: float, lags: np.ndarray) -> np.ndarray:
@@ -104,6 +108,30 @@ def av_fn(b2: float, m: np.ndarray) -> np.ndarray:
     return (b2 * ((t1 - t2) / (2 * mm * mm))).astype(np.float64)
 
 
+@functools.lru_cache(maxsize=1)
+def _flicker_head() -> tuple[np.ndarray, float]:
+    exact = av_fn(1.0, np.arange(1, FLICKER_EXACT + 1))
+    # AV(m) / (2 ln 2 / pi) - 1 = (c0 + (3/16) log2 m) / m^2 + O(log m / m^4): c0 from the last exact value
+    c0 = (exact[-1] / FLICKER_AV_FACTOR - 1.0) * FLICKER_EXACT**2 - 0.1875 * math.log2(FLICKER_EXACT)
+    return exact, c0
+
+
+def flicker_unit_av(m: np.ndarray) -> np.ndarray:
+    """Allan variance of unit flicker FN(b2=1) at factors m: exact up to 4096, then its expansion (1e-14).
+
+    >>> bool(abs(flicker_unit_av(np.array([2.0**20]))[0] / av_fn(1.0, np.array([2**20]))[0] - 1) < 1e-13)
+    True
+    """
+    m = np.asarray(m, dtype=np.float64)
+    exact, c0 = _flicker_head()
+    small = m <= FLICKER_EXACT
+    out = np.empty(m.shape)
+    out[small] = exact[m[small].astype(np.int64) - 1]
+    big = m[~small]
+    out[~small] = FLICKER_AV_FACTOR * (1.0 + (c0 + 0.1875 * np.log2(big)) / big**2)
+    return out
+
+
 def _embedding_roots(n: int) -> np.ndarray:
     """sqrt(eigenvalues / M) of the circulant embedding of unit-b2 increments, size M >= 2 (n - 1)."""
     from scipy.fft import next_fast_len, rfft
@@ -145,6 +173,10 @@ class FN(Process):
 
     b2: float
     name: ClassVar[str] = "FN"
+    scale_field: ClassVar[str] = "b2"
+    slope: ClassVar[float] = 0.0
+    ad_coefficient: ClassVar[float] = math.sqrt(FLICKER_AV_FACTOR)
+    coefficient_label: ClassVar[str] = "B [u]"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "b2", check_real(self.b2, "b2", minimum=0.0))
@@ -189,3 +221,18 @@ class FN(Process):
     def _av(self, m: np.ndarray) -> np.ndarray:
         flat = np.asarray(m, dtype=np.int64).reshape(-1)
         return av_fn(self.b2, flat).reshape(np.shape(m))
+
+    @staticmethod
+    def unit_av(m: np.ndarray, shape: float | None = None) -> np.ndarray:
+        """:func:`flicker_unit_av`."""
+        return flicker_unit_av(m)
+
+    @staticmethod
+    def ieee_av(tau: np.ndarray) -> np.ndarray:
+        """2 ln 2 / pi at every tau: AD = 0.664 B."""
+        return np.full_like(tau, FLICKER_AV_FACTOR)
+
+    @classmethod
+    def coefficient(cls, scale: float, freq: float) -> float:
+        """B = sqrt(b2), in u, at any rate."""
+        return math.sqrt(scale)

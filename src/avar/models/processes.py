@@ -13,13 +13,16 @@ The processes are parametrized *per sample*, as in the R package ``simts``
                           started from its stationary law N(0, sigma2 / (1 - phi^2))
 ========================  =====================================================
 
-Processes add with ``+`` into a :class:`CompositeModel`; every model, single
-or composite, can :meth:`~NoiseModel.simulate` itself and gives its
-:meth:`~NoiseModel.theoretical_av` (the sum of the closed forms of
+Processes add with ``+`` into a :class:`~avar.models.base.CompositeModel`; every model, single
+or composite, can :meth:`~avar.models.base.NoiseModel.simulate` itself and gives its
+:meth:`~avar.models.base.NoiseModel.theoretical_av` (the sum of the closed forms of
 :mod:`avar.models.theory`) at averaging factors m. Because the parameters are per
 sample, the sampling rate plays no part in simulation: a model fitted on an
 Allan variance in seconds is converted to per-sample parameters first (see
-:func:`avar.fit.slopes.per_sample_model`).
+:func:`avar.fit.slopes.per_sample_model`). Each class also describes the process
+as a term of a fitted model (:class:`~avar.models.base.Process`): the variance
+its Allan variance is linear in, that Allan variance per unit, and IEEE 952's
+slope and continuous-time coefficient.
 
 References
 ----------
@@ -30,182 +33,18 @@ measurement data", Metrologia 45(5):549-561, 2008.
 
 from __future__ import annotations
 
-import numbers
-from dataclasses import dataclass, fields
-from typing import Any, ClassVar
+import math
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from avar import _kernels
-from avar._validation import check_count, check_freq, check_real, check_seed, check_whole_numbers, short_repr
+from avar._validation import check_freq, check_real
 from avar.models import theory
+from avar.models.base import Process
 
-__all__ = ["NoiseModel", "Process", "CompositeModel", "WN", "QN", "RW", "DR", "AR1"]
-
-
-def format_parameter(value: float) -> str:
-    """Shortest exact text of a float, without a trailing ``.0``: 1.0 -> ``1``."""
-    text = repr(float(value))
-    return text[:-2] if text.endswith(".0") else text
-
-
-# --------------------------------------------------------------------------- models
-class NoiseModel:
-    """Behaviour shared by single processes and their sums.
-
-    Subclasses give ``components`` (the processes, in order) and, for a
-    single process, ``_fill``.
-    """
-
-    components: tuple[Process, ...]
-
-    def __add__(self, other: Any) -> CompositeModel:
-        if not isinstance(other, NoiseModel):
-            return NotImplemented
-        return CompositeModel(self.components + other.components)
-
-    def __radd__(self, other: Any) -> NoiseModel:
-        # ``sum(models)`` starts from 0
-        if isinstance(other, numbers.Number) and other == 0:
-            return self
-        return NotImplemented
-
-    @property
-    def parameter_vector(self) -> np.ndarray:
-        """All parameters in component order, float64 (``WN + RW`` -> [sigma2, gamma2])."""
-        return np.array([value for process in self.components for value in process.parameters.values()])
-
-    @property
-    def parameter_names(self) -> tuple[str, ...]:
-        """Labels of :attr:`parameter_vector`, ``"<process>.<parameter>"``."""
-        return tuple(f"{p.name}.{key}" for p in self.components for key in p.parameters)
-
-    def theoretical_av(self, m: Any) -> float | np.ndarray:
-        """Theoretical Allan variance at averaging factors ``m``.
-
-        The sum over the components of the closed forms of :mod:`avar.models.theory`
-        (WN sigma2 / m; QN 3 q2 / m^2; RW (2 m^2 + 1) gamma2 / (6 m);
-        DR m^2 omega^2 / 2; AR1 Zhang 2008), in squared data units.
-
-        Parameters
-        ----------
-        m : int or array_like of int
-            Averaging factors (cluster sizes in samples), whole numbers >= 1.
-
-        Returns
-        -------
-        float or ndarray
-            A float for a scalar ``m``, else a float64 array shaped like ``m``.
-
-        Examples
-        --------
-        >>> (WN(sigma2=1) + RW(gamma2=0.5)).theoretical_av([1, 2])
-        array([1.25 , 0.875])
-        """
-        factors = check_whole_numbers(m, "m")
-        if np.any(factors < 1):
-            raise ValueError(f"m must hold averaging factors >= 1, got {short_repr(m)}")
-        factors = factors.reshape(np.shape(m))
-        total = sum(np.asarray(p._av(factors), dtype=np.float64) for p in self.components)
-        return float(total) if np.ndim(m) == 0 else total
-
-    def simulate(self, n: int, seed: Any = None) -> np.ndarray:
-        """Simulate ``n`` samples of the model (the sum of its components).
-
-        Parameters
-        ----------
-        n : int
-            Length of the series, >= 1.
-        seed : None, int, array_like, numpy.random.SeedSequence or numpy.random.Generator
-            Passed to :func:`numpy.random.default_rng`; the same seed gives the
-            same series. A Generator is used (and advanced) as is.
-
-        Returns
-        -------
-        ndarray of float64, shape (n,)
-
-        Examples
-        --------
-        >>> x = (WN(sigma2=1) + DR(omega=0.5)).simulate(5, seed=1)
-        >>> x.shape, bool(np.all(x == (WN(sigma2=1) + DR(omega=0.5)).simulate(5, seed=1)))
-        ((5,), True)
-        """
-        return self.simulate_replicates(n, 1, seed)[0]
-
-    def simulate_replicates(self, n: int, replicates: int, seed: Any = None) -> np.ndarray:
-        """Simulate ``replicates`` independent series of length ``n`` at once.
-
-        Returns a C-contiguous float64 array of shape (replicates, n), one
-        series per row (pass ``.T`` to :func:`avar.stability.allan.columns.allan_variance_columns`).
-        Row 0 of a single replicate equals :meth:`simulate` with the same seed.
-
-        Examples
-        --------
-        >>> RW(gamma2=1).simulate_replicates(1000, 3, seed=0).shape
-        (3, 1000)
-        """
-        n = check_count(n, "n")
-        replicates = check_count(replicates, "replicates")
-        out = np.empty((replicates, n))
-        with np.errstate(over="ignore", invalid="ignore"):
-            self.simulate_into(out, np.random.default_rng(check_seed(seed)))
-        if not np.isfinite(out).all():  # e.g. DR(omega=1e306): omega t passes the float64 limit
-            raise ValueError(f"the simulation of {self!r} overflows float64 within {n} samples; rescale the "
-                             "model's parameters (e.g. other units) or simulate fewer samples")
-        return out
-
-    def simulate_into(self, out: np.ndarray, rng: np.random.Generator) -> None:
-        """Overwrite ``out`` with independent series of the model, one per row.
-
-        ``out`` is a C-contiguous float64 array of shape (replicates, n),
-        reused across calls to avoid allocating (the bootstrap of
-        the AVLR bootstrap (:mod:`avar.fit.bootstrap`) fills it chunk by chunk); ``rng`` is advanced.
-
-        Examples
-        --------
-        >>> out = np.empty((2, 3))
-        >>> DR(omega=1).simulate_into(out, np.random.default_rng(0))
-        >>> out
-        array([[1., 2., 3.],
-               [1., 2., 3.]])
-        """
-        if not (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.ndim == 2 and out.flags.c_contiguous):
-            raise TypeError("out must be a C-contiguous float64 array of shape (replicates, n)")
-        if not isinstance(rng, np.random.Generator):
-            raise TypeError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
-        first, *rest = self.components
-        first._fill(out, rng)
-        if rest:
-            scratch = np.empty_like(out)
-            for process in rest:
-                process._fill(scratch, rng)
-                out += scratch
-
-
-@dataclass(frozen=True)
-class Process(NoiseModel):
-    """One latent process; see the module docstring for the definitions."""
-
-    name: ClassVar[str] = ""
-
-    @property
-    def components(self) -> tuple[Process, ...]:  # type: ignore[override]
-        return (self,)
-
-    @property
-    def parameters(self) -> dict[str, float]:
-        """Parameter names and values, in definition order."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    def __repr__(self) -> str:
-        inner = ", ".join(f"{key}={format_parameter(v)}" for key, v in self.parameters.items())
-        return f"{self.name}({inner})"
-
-    def _fill(self, out: np.ndarray, rng: np.random.Generator) -> None:  # pragma: no cover
-        raise NotImplementedError
-
-    def _av(self, m: np.ndarray) -> np.ndarray:  # pragma: no cover
-        raise NotImplementedError
+__all__ = ["WN", "QN", "RW", "DR", "AR1"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -220,6 +59,10 @@ class WN(Process):
 
     sigma2: float
     name: ClassVar[str] = "WN"
+    scale_field: ClassVar[str] = "sigma2"
+    slope: ClassVar[float] = -0.5
+    ad_coefficient: ClassVar[float] = 1.0
+    coefficient_label: ClassVar[str] = "sigma [u s^1/2]"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "sigma2", check_real(self.sigma2, "sigma2", minimum=0.0))
@@ -243,6 +86,21 @@ class WN(Process):
     def _av(self, m: np.ndarray) -> np.ndarray:
         return theory.av_wn(self.sigma2, m)
 
+    @staticmethod
+    def unit_av(m: np.ndarray, shape: float | None = None) -> np.ndarray:
+        """1 / m."""
+        return 1.0 / np.asarray(m, dtype=np.float64)
+
+    @staticmethod
+    def ieee_av(tau: np.ndarray) -> np.ndarray:
+        """1 / tau: AD(tau) = N / sqrt(tau)."""
+        return 1.0 / tau
+
+    @classmethod
+    def coefficient(cls, scale: float, freq: float) -> float:
+        """N = sqrt(sigma2 / f), in u s^1/2 = u / sqrt(Hz)."""
+        return math.sqrt(scale / freq)
+
 
 @dataclass(frozen=True, repr=False)
 class QN(Process):
@@ -258,6 +116,10 @@ class QN(Process):
 
     q2: float
     name: ClassVar[str] = "QN"
+    scale_field: ClassVar[str] = "q2"
+    slope: ClassVar[float] = -1.0
+    ad_coefficient: ClassVar[float] = float(np.sqrt(3.0))
+    coefficient_label: ClassVar[str] = "Q [u s]"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "q2", check_real(self.q2, "q2", minimum=0.0))
@@ -282,6 +144,21 @@ class QN(Process):
     def _av(self, m: np.ndarray) -> np.ndarray:
         return theory.av_qn(self.q2, m)
 
+    @staticmethod
+    def unit_av(m: np.ndarray, shape: float | None = None) -> np.ndarray:
+        """3 / m^2."""
+        return 3.0 / np.asarray(m, dtype=np.float64) ** 2
+
+    @staticmethod
+    def ieee_av(tau: np.ndarray) -> np.ndarray:
+        """3 / tau^2: AD(tau) = sqrt(3) Q / tau."""
+        return 3.0 / tau**2
+
+    @classmethod
+    def coefficient(cls, scale: float, freq: float) -> float:
+        """Q = sqrt(q2) / f, in u s."""
+        return math.sqrt(scale) / freq
+
 
 @dataclass(frozen=True, repr=False)
 class RW(Process):
@@ -297,6 +174,10 @@ class RW(Process):
 
     gamma2: float
     name: ClassVar[str] = "RW"
+    scale_field: ClassVar[str] = "gamma2"
+    slope: ClassVar[float] = 0.5
+    ad_coefficient: ClassVar[float] = float(1.0 / np.sqrt(3.0))
+    coefficient_label: ClassVar[str] = "gamma [u s^-1/2]"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "gamma2", check_real(self.gamma2, "gamma2", minimum=0.0))
@@ -323,6 +204,22 @@ class RW(Process):
     def _av(self, m: np.ndarray) -> np.ndarray:
         return theory.av_rw(self.gamma2, m)
 
+    @staticmethod
+    def unit_av(m: np.ndarray, shape: float | None = None) -> np.ndarray:
+        """(2 m^2 + 1) / (6 m)."""
+        m = np.asarray(m, dtype=np.float64)
+        return (2.0 * m**2 + 1.0) / (6.0 * m)
+
+    @staticmethod
+    def ieee_av(tau: np.ndarray) -> np.ndarray:
+        """tau / 3: AD(tau) = K sqrt(tau / 3)."""
+        return tau / 3.0
+
+    @classmethod
+    def coefficient(cls, scale: float, freq: float) -> float:
+        """K = sqrt(gamma2 f), in u / s^1/2."""
+        return math.sqrt(scale * freq)
+
 
 @dataclass(frozen=True, repr=False)
 class DR(Process):
@@ -336,6 +233,10 @@ class DR(Process):
 
     omega: float
     name: ClassVar[str] = "DR"
+    scale_field: ClassVar[str] = "omega"
+    slope: ClassVar[float] = 1.0
+    ad_coefficient: ClassVar[float] = float(1.0 / np.sqrt(2.0))
+    coefficient_label: ClassVar[str] = "omega [u s^-1]"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "omega", check_real(self.omega, "omega"))
@@ -358,6 +259,26 @@ class DR(Process):
     def _av(self, m: np.ndarray) -> np.ndarray:
         return theory.av_dr(self.omega, m)
 
+    @property
+    def scale(self) -> float:
+        """omega^2: the Allan variance is m^2 omega^2 / 2."""
+        return self.omega * self.omega
+
+    @staticmethod
+    def unit_av(m: np.ndarray, shape: float | None = None) -> np.ndarray:
+        """m^2 / 2."""
+        return np.asarray(m, dtype=np.float64) ** 2 / 2.0
+
+    @staticmethod
+    def ieee_av(tau: np.ndarray) -> np.ndarray:
+        """tau^2 / 2: AD(tau) = R tau / sqrt(2)."""
+        return tau**2 / 2.0
+
+    @classmethod
+    def coefficient(cls, scale: float, freq: float) -> float:
+        """R = sqrt(omega^2) f, the slope's size per second, in u / s."""
+        return math.sqrt(scale) * freq
+
 
 @dataclass(frozen=True, repr=False)
 class AR1(Process):
@@ -376,6 +297,8 @@ class AR1(Process):
     phi: float
     sigma2: float
     name: ClassVar[str] = "AR1"
+    scale_field: ClassVar[str] = "sigma2"
+    shape_field: ClassVar[str] = "phi"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "phi", check_real(self.phi, "phi", bound=1.0))
@@ -390,35 +313,9 @@ class AR1(Process):
     def _av(self, m: np.ndarray) -> np.ndarray:
         return theory.av_ar1(m, self.phi, self.sigma2)
 
+    @staticmethod
+    def unit_av(m: np.ndarray, shape: float | None = None) -> np.ndarray:
+        """Zhang's form per unit sigma2 at phi = ``shape``, 1/2 < phi < 1 (:func:`avar.models.theory.ar1_unit_av`)."""
+        return theory.ar1_unit_av(m, shape)
 
-@dataclass(frozen=True)
-class CompositeModel(NoiseModel):
-    """A sum of processes, built with ``+``: ``WN(sigma2=1) + RW(gamma2=1e-06)``.
 
-    Sums are flat (``(a + b) + c`` has three components) and ordered: two
-    composites are equal when they have equal components in the same order.
-
-    Examples
-    --------
-    >>> model = WN(sigma2=1) + RW(gamma2=1e-06)
-    >>> model
-    WN(sigma2=1) + RW(gamma2=1e-06)
-    >>> model.parameter_vector
-    array([1.e+00, 1.e-06])
-    >>> model == WN(sigma2=1.0) + RW(gamma2=1e-6)
-    True
-    """
-
-    components: tuple[Process, ...]
-
-    def __post_init__(self) -> None:
-        components = tuple(self.components)
-        if not components or not all(isinstance(p, Process) for p in components):
-            raise TypeError("a CompositeModel needs one or more processes (WN, QN, RW, DR, AR1, FN)")
-        object.__setattr__(self, "components", components)
-
-    def __repr__(self) -> str:
-        return " + ".join(repr(p) for p in self.components)
-
-    def __len__(self) -> int:
-        return len(self.components)

@@ -33,7 +33,7 @@ from typing import ClassVar
 import numpy as np
 
 from avar._validation import check_freq, check_real
-from avar.models.processes import Process
+from avar.models.base import Process
 
 __all__ = ["SIN", "av_sin"]
 
@@ -71,6 +71,8 @@ class SIN(Process):
     a2: float
     f: float
     name: ClassVar[str] = "SIN"
+    scale_field: ClassVar[str] = "a2"
+    shape_field: ClassVar[str] = "f"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "a2", check_real(self.a2, "a2", minimum=0.0))
@@ -102,3 +104,8 @@ class SIN(Process):
 
     def _av(self, m: np.ndarray) -> np.ndarray:
         return av_sin(m, self.a2, self.f)
+
+    @staticmethod
+    def unit_av(m: np.ndarray, shape: float | None = None) -> np.ndarray:
+        """:func:`av_sin` per unit a2 at f = ``shape``."""
+        return av_sin(m, 1.0, shape)

@@ -9,6 +9,7 @@ from matplotlib.axes import Axes
 from matplotlib.colors import to_rgba
 from matplotlib.figure import Figure
 
+from avar._escape import figure_text
 from avar.plotting.base import (
     axis_labels,
     check_colour,
@@ -30,7 +31,7 @@ def compare_items(results: Any, labels: Any) -> list[tuple[str, AllanVariance]]:
     if isinstance(results, Mapping):
         if labels is not None:
             raise ValueError("give the labels either as the keys of a mapping or as labels=, not both")
-        labels, results = [str(k) for k in results], list(results.values())
+        labels, results = [figure_text(k) for k in results], list(results.values())  # names from data
     elif isinstance(results, str) or not isinstance(results, Sequence):
         hint = " (for an IMU pass its .channels)" if hasattr(results, "channels") else ""
         raise TypeError(
@@ -47,7 +48,7 @@ def compare_items(results: Any, labels: Any) -> list[tuple[str, AllanVariance]]:
         check_result(res, f"results[{i}]")
         items.append(res)
     if labels is None:
-        labels = [res.name or f"Series {i + 1}" for i, res in enumerate(items)]
+        labels = [figure_text(res.name) if res.name else f"Series {i + 1}" for i, res in enumerate(items)]
     else:
         if isinstance(labels, str) or not isinstance(labels, Sequence):
             raise TypeError(f"labels must be a list of strings, got {labels!r}")

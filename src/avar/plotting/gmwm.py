@@ -8,6 +8,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from avar._escape import figure_text
 from avar.plotting.base import (
     IMPLIED_COLOUR,
     band,
@@ -101,7 +102,7 @@ def plot_imu_gmwm(x: Any, decomp: bool = True, deviation: bool = True, **kwargs:
     for name, kind, axis in zip(imu.channels, imu.sensor_types, imu.axes):
         cell = (rows.index(kind), columns.index(axis))
         used.add(cell)
-        plot_gmwm(x.fits[name], decomp=decomp, deviation=deviation, main=name,
+        plot_gmwm(x.fits[name], decomp=decomp, deviation=deviation, main=figure_text(name),
                   legend_position="lower left" if not used - {cell} else None, ax=panels[cell], **kwargs)
     for cell in np.ndindex(panels.shape):
         if cell not in used:

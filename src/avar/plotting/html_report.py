@@ -3,7 +3,7 @@
 :func:`report_html` returns the page as a string; nothing is fetched when it is opened
 (no scripts, no external style sheets or images), so it can be mailed or attached to a
 test report as it is. Every text that comes from the data or the user (file and channel
-names, the command line, warnings, table cells) is escaped with :func:`html.escape`.
+names, the command line, warnings, table cells) is escaped with :func:`avar._escape.html_text`.
 
 The tables are rendered generically: every column of the report's ``table`` (and of
 its ``curves`` when the report has them), with missing values as empty cells and
@@ -12,11 +12,12 @@ floats to 4 significant digits.
 
 from __future__ import annotations
 
-import html
 import io
 import math
 import re
 from typing import Any
+
+from avar._escape import html_text
 
 __all__ = ["report_html", "svg_of"]
 
@@ -59,13 +60,13 @@ def _cell(value: Any) -> tuple[str, bool]:
 
 def _table(frame: Any, css: str) -> str:
     """A pandas DataFrame as an escaped HTML table, every column, no index."""
-    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in frame.columns)
+    head = "".join(f"<th>{html_text(str(c))}</th>" for c in frame.columns)
     rows = []
     for values in frame.itertuples(index=False, name=None):
         cells = []
         for value in values:
             text, number = _cell(value)
-            cells.append(f'<td class="number">{html.escape(text)}</td>' if number else f"<td>{html.escape(text)}</td>")
+            cells.append(f'<td class="number">{html_text(text)}</td>' if number else f"<td>{html_text(text)}</td>")
         rows.append("<tr>" + "".join(cells) + "</tr>")
     return (f'<div class="scroll"><table class="{css}"><thead><tr>{head}</tr></thead>\n<tbody>\n'
             + "\n".join(rows) + "\n</tbody></table></div>")
@@ -73,7 +74,7 @@ def _table(frame: Any, css: str) -> str:
 
 def _meta(items: list[tuple[str, str]]) -> str:
     return '<dl class="meta">' + "".join(
-        f"<dt>{html.escape(k)}</dt><dd>{html.escape(v)}</dd>" for k, v in items if v) + "</dl>"
+        f"<dt>{html_text(k)}</dt><dd>{html_text(v)}</dd>" for k, v in items if v) + "</dl>"
 
 
 def report_html(report: Any, command: str | None = None, source: str | None = None,
@@ -127,16 +128,16 @@ def report_html(report: Any, command: str | None = None, source: str | None = No
             ("Command", command or ""), ("avar version", __version__)]
     warnings = [str(w) for w in getattr(report, "warnings", ()) or ()]
     parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
-             f"<title>Noise report: {html.escape(str(name))}</title>", f"<style>{STYLE}</style></head><body>",
-             f"<h1>Noise report: {html.escape(str(name))}</h1>", _meta(meta)]
+             f"<title>Noise report: {html_text(str(name))}</title>", f"<style>{STYLE}</style></head><body>",
+             f"<h1>Noise report: {html_text(str(name))}</h1>", _meta(meta)]
     parts.append('<section class="warnings"><h2>Warnings</h2>' + (
-        "<ul>" + "".join(f"<li>{html.escape(w)}</li>" for w in warnings) + "</ul>" if warnings
+        "<ul>" + "".join(f"<li>{html_text(w)}</li>" for w in warnings) + "</ul>" if warnings
         else "<p>none</p>") + "</section>")
     parts.append("<section><h2>Terms</h2>" + _table(report.table, "terms") + "</section>")
     parts.append("<section><h2>Figures</h2>" + "".join(f"<figure>{svg}</figure>" for svg in svgs) + "</section>")
     curves = getattr(report, "curves", None)
     if curves is not None and len(curves):
-        parts.append("<section><h2>Curves</h2><details><summary>" + html.escape(f"{len(curves)} rows")
+        parts.append("<section><h2>Curves</h2><details><summary>" + html_text(f"{len(curves)} rows")
                      + "</summary>" + _table(curves, "curves") + "</details></section>")
     parts.append("</body></html>\n")
     return "\n".join(parts)

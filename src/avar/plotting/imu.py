@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure, FigureBase
 
+from avar._escape import figure_text
 from avar.plotting.base import (
     AD_COLOUR,
     CI_COLOUR,
@@ -115,7 +116,7 @@ def draw_grid(
                                       (scales or {}).get(kind), deviation=deviation, colour=col_implied,
                                       marker=marker, markersize=markersize, widths=(1.8, 1.1)))
             if all((rr, c) not in cells for rr in range(r)):
-                ax.set_title(f"Axis - {axis}")
+                ax.set_title(f"Axis - {figure_text(axis)}")
             if all((r, cc) not in cells for cc in range(c)):
                 ax.set_ylabel(row_label(kind, imu.units.get(kind), deviation, ylab))
             if legend_axes is None:
@@ -131,7 +132,7 @@ def draw_grid(
         grid[r, min(c for rr, c in cells if rr == r)].yaxis.set_tick_params(labelleft=True)
     fig.supxlabel(r"Averaging time $\tau$ (s)" if xlab is None else xlab)
     if main is None:
-        main = f"Allan Variance Representation - {imu.sensor} @ {imu.freq:g} Hz"
+        main = f"Allan Variance Representation - {figure_text(imu.sensor)} @ {imu.freq:g} Hz"
     if main:
         fig.suptitle(main)
     if legend is not None and legend_axes is not None:

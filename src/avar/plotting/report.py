@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
+from avar._escape import figure_text
 from avar.plotting.base import (
     AD_COLOUR,
     CI_COLOUR,
@@ -137,7 +138,7 @@ def plot_report(
             _panel(ax, report, row[c], deviation, power, implied, ci, legend)
             if customary_axis and deviation:
                 _customary_axis(ax, report, row[c])
-    fig.suptitle(f"Noise report: {report.name}" + (f" ({report.topic})" if report.topic else ""))
+    fig.suptitle(f"Noise report: {figure_text(report.name)}" + (f" ({figure_text(report.topic)})" if report.topic else ""))
     return fig
 
 
@@ -204,7 +205,7 @@ def _panel(ax: Any, report: Any, channel: str, deviation: bool, power: int, impl
                   f"{quantity} [({unit})^2]" if unit else quantity)
     ax.set_xlabel(r"Averaging time $\tau$ [s]")
     kind = report.sensor_types[index]
-    title = channel + (f" ({kind.lower()})" if kind else "")
+    title = figure_text(channel) + (f" ({kind.lower()})" if kind else "")  # a name from data, drawn literally
     curves = report.curves[report.curves["Channel"] == channel]
     if len(curves) and curves["Fits"].mean() < 0.9:
         title += f"\nfit fails at {int((~curves['Fits'].astype(bool)).sum())} of {len(curves)} levels"

@@ -56,6 +56,8 @@ def plain_loop(code, hi, lo, m, stride, first, last):
             d = p[b + 2 * m] - 2 * p[b + m] + p[b]
         elif code in (1, 2):
             d = p[b + 3 * m] - 3 * p[b + 2 * m] + 3 * p[b + m] - p[b]
+        elif code == 4:
+            d = p[b + 4 * m] - 4 * p[b + 3 * m] + 6 * p[b + 2 * m] - 4 * p[b + m] + p[b]
         else:
             def star(j):
                 return 2 * p[0] - p[-j] if j < 0 else (2 * p[n] - p[2 * n - j] if j > n else p[j])
@@ -64,13 +66,14 @@ def plain_loop(code, hi, lo, m, stride, first, last):
     return total
 
 
-@pytest.mark.parametrize("estimator", ["adev", "oadev", "hdev", "ohdev", "totdev", "mdev"])
+@pytest.mark.parametrize("estimator", ["adev", "oadev", "hdev", "ohdev", "totdev", "mdev", "mhdev"])
 def test_level_sums_match_plain_loops(estimator):
     rng = np.random.default_rng(1)
     hi = np.cumsum(rng.standard_normal(3001))
     lo = (rng.standard_normal(3001) * 1e-17).astype(np.float32)
-    factors = deviation_factors(estimator, 3001 - (estimator == "mdev"), taus="all")[::37]
-    strides, first, last = term_ranges(estimator, 3001 - (estimator == "mdev"), factors)
+    modified = estimator in ("mdev", "mhdev")  # hi is the running sum: one point more than the phase
+    factors = deviation_factors(estimator, 3001 - modified, taus="all")[::37]
+    strides, first, last = term_ranges(estimator, 3001 - modified, factors)
     sums, counts = level_sums(hi, lo, KERNEL_CODES[estimator], factors, strides, first, last, chunk=256)
     for i, m in enumerate(factors):
         expected = plain_loop(KERNEL_CODES[estimator], hi, lo, int(m), int(strides[i]), int(first[i]), int(last[i]))

@@ -1,6 +1,9 @@
-"""The deviation family avar.adev ... avar.totdev against allantools, exact arithmetic and NIST."""
+"""The deviation family avar.adev ... avar.totdev, avar.mhdev, avar.htdev against allantools, exact
+arithmetic, plain loops and NIST."""
 
 from __future__ import annotations
+
+import math
 
 import allantools
 import numpy as np
@@ -35,10 +38,14 @@ def allantools_result(estimator, data, data_type, taus):
     return getattr(allantools, estimator)(data, rate=RATE, data_type=data_type, taus=taus)
 
 
+#: The statistics allantools computes (it has no modified Hadamard deviation, nor HTDEV).
+IN_ALLANTOOLS = [name for name in ESTIMATORS if hasattr(allantools, name)]
+
+
 @pytest.mark.filterwarnings("ignore")
 @pytest.mark.parametrize("kind", ["white", "flicker", "random walk"])
 @pytest.mark.parametrize("n", [10, 101, 1000, 10_000])
-@pytest.mark.parametrize("estimator", ESTIMATORS)
+@pytest.mark.parametrize("estimator", IN_ALLANTOOLS)
 def test_equals_allantools(estimator, n, kind):
     """Same taus, same n, values to 1e-10; ours adds only levels with a single term."""
     data = power_law(kind, n, seed=n) * 1e-9
@@ -60,7 +67,8 @@ def test_largest_level_has_one_term(estimator):
     data = power_law("white", 37, seed=1)
     res = getattr(avar, estimator)(data, data_type="phase", taus="all")
     assert res.averaging_factors[-1] == max_factor(estimator, 37)
-    expected = {"adev": 1, "oadev": 1, "mdev": 2, "tdev": 2, "hdev": 1, "ohdev": 1, "totdev": 35}  # 37 - 36 + 1 for MDEV
+    expected = {"adev": 1, "oadev": 1, "mdev": 2, "tdev": 2, "hdev": 1, "ohdev": 1, "totdev": 35,  # 37 - 36 + 1 for MDEV
+                "mhdev": 2, "htdev": 2}  # 37 - 36 + 1 at m = 9
     assert res.n[-1] == expected[estimator]
     with pytest.raises(ValueError, match="outside the valid range"):
         getattr(avar, estimator)(data, data_type="phase", taus=[max_factor(estimator, 37) + 1])
@@ -120,7 +128,7 @@ NBS14_1000 = {
 }
 
 
-@pytest.mark.parametrize("estimator", ESTIMATORS)
+@pytest.mark.parametrize("estimator", NBS14_1000)
 def test_nist_nbs14_1000_point(estimator):
     y = nbs14_1000()
     phase = np.concatenate(([0.0], np.cumsum(y - y.mean())))
@@ -139,10 +147,64 @@ def test_tdev_is_tau_over_sqrt3_mdev():
 def test_hadamard_ignores_frequency_drift():
     y = power_law("white", 2000, 4)
     drifted = y + 1e3 + 0.5 * np.arange(2000)
-    for estimator in ("hdev", "ohdev"):
+    for estimator in ("hdev", "ohdev", "mhdev", "htdev"):
         a = getattr(avar, estimator)(y, taus="all").variance
         b = getattr(avar, estimator)(drifted, taus="all").variance
         np.testing.assert_allclose(b, a, rtol=1e-9)
+
+
+def plain_mhdev(x: np.ndarray, m: int, rate: float) -> tuple[float, int]:
+    """MHVAR by its definition (NIST SP 1065 section 5.2.10), a plain loop over the phase x (s)::
+
+        sum_{j=0}^{N-4m} [sum_{i=j}^{j+m-1} (x_{i+3m} - 3 x_{i+2m} + 3 x_{i+m} - x_i)]^2 / (6 m^2 tau^2 (N - 4m + 1))
+    """
+    n = x.size
+    tau = m / rate
+    total = []
+    for j in range(n - 4 * m + 1):
+        inner = 0.0
+        for i in range(j, j + m):
+            inner += x[i + 3 * m] - 3.0 * x[i + 2 * m] + 3.0 * x[i + m] - x[i]
+        total.append(inner * inner)
+    return math.fsum(total) / (6.0 * m * m * tau * tau * len(total)), len(total)
+
+
+@pytest.mark.parametrize("kind", ["white", "flicker", "random walk"])
+def test_mhdev_and_htdev_equal_plain_loops(kind):
+    """MHDEV and HTDEV = tau / sqrt(10/3) MHDEV against a plain loop over the definition, to 1e-10."""
+    data = power_law(kind, 700, seed=11) * 1e-9
+    for data_type in ("freq", "phase"):
+        x = np.concatenate(([0.0], np.cumsum(data))) / RATE if data_type == "freq" else data
+        mh = avar.mhdev(data, rate=RATE, data_type=data_type, taus="all")
+        ht = avar.htdev(data, rate=RATE, data_type=data_type, taus="all")
+        assert mh.averaging_factors[-1] == x.size // 4 and mh.n[-1] == x.size - 4 * (x.size // 4) + 1
+        for k in list(range(0, mh.taus.size, 17)) + [mh.taus.size - 1]:
+            m = int(mh.averaging_factors[k])
+            variance, count = plain_mhdev(x, m, RATE)
+            assert mh.n[k] == ht.n[k] == count
+            assert mh.variance[k] == pytest.approx(variance, rel=1e-10)
+            tau = m / RATE
+            assert ht.variance[k] == pytest.approx(variance * tau * tau * 3 / 10, rel=1e-10)
+        np.testing.assert_array_equal(ht.alpha, mh.alpha)
+        np.testing.assert_allclose(ht.edf, mh.edf, rtol=0)
+
+
+def test_htdev_is_the_phase_deviation_of_white_pm():
+    """The factor sqrt(10/3): HTDEV of white PM of standard deviation s is s / sqrt(m), as TDEV."""
+    x = np.random.default_rng(12).standard_normal(200_000) * 1e-9
+    res = avar.htdev(x, data_type="phase", taus=[1, 4, 16])
+    np.testing.assert_allclose(res.deviation * np.sqrt(res.averaging_factors), 1e-9, rtol=0.02)
+    assert res.alpha.tolist() == [2, 2, 2]
+
+
+def test_mhdev_edf_is_greenhalls_modified_hadamard():
+    from avar.stability.uncertainty.edf import greenhall_edf
+
+    y = power_law("white", 3000, 13)
+    res = avar.mhdev(y, taus="octave")
+    expected = greenhall_edf(res.alpha, 3, res.averaging_factors, 3001, overlapping=True, modified=True)
+    np.testing.assert_allclose(res.edf, expected, rtol=1e-14)
+    assert np.all((res.lci < res.deviation) & (res.deviation < res.uci))
 
 
 def test_result_fields_summary_and_text():

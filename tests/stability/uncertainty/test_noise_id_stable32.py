@@ -115,7 +115,7 @@ def test_b1_rule_thresholds():
 
 def test_noise_rules_are_the_lag1_dmax():
     assert {name: int(rule) for name, rule in NOISE_ID_ESTIMATORS.items()} == {
-        "adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3,
+        "adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3, "mhdev": 3, "htdev": 3,
         "mtotdev": 2, "ttotdev": 2, "htotdev": 2}
     assert all(rule.estimator == name for name, rule in NOISE_ID_ESTIMATORS.items())
 

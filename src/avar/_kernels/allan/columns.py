@@ -4,12 +4,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from avar._kernels.allan.blocks import BLOCK, CERTIFY_TOL, CHUNK_BLOCKS, LIMIT_EXP, NEAR, block_table, read_only
+from avar._kernels.allan.blocks import (
+    BLOCK,
+    CERTIFY_TOL,
+    CHUNK_BLOCKS,
+    LIMIT_EXP,
+    NEAR,
+    block_table,
+    read_only,
+    table_task,
+)
 from avar._kernels.allan.far import FAR_SPAN, SWEEP_FINE, far_sums
 from avar._kernels.allan.haar import CHUNK_BLOCKS as HAAR_CHUNK
-from avar._kernels.allan.haar import PYRAMID_EXP, haar_sums
-from avar._kernels.allan.levels import level_sums
-from avar._kernels.allan.small import small_allan_variance, small_allan_variance_parallel
+from avar._kernels.allan.haar import HAAR_KERNEL, PYRAMID_EXP, haar_sums
+from avar._kernels.allan.levels import level_sums, to_task
+from avar._kernels.allan.small import PARALLEL_KERNEL, small_allan_variance, small_allan_variance_parallel
 from avar._kernels.allan.sweep import SWEEP_BLOCK, SWEEP_CHUNK, SWEEP_NEAR, sweep_sums
 
 #: Series of at most this many samples take the one-call small path
@@ -127,6 +136,22 @@ def _as_kernel_input(data) -> np.ndarray:
     elif x.dtype == np.float16:
         x = x.astype(np.float32)  # exact; numba has no float16 arithmetic
     return read_only(x)
+
+
+def column_kernels(data, factors, type: str) -> tuple:
+    """The compiled loops :func:`allan_variance_columns` runs on series of up to
+    :data:`SMALL_MO_MAX` samples, as ``(kernel, first argument)`` entries of
+    :func:`avar._kernels.runtime.paths.compiled` (whether they are compiled yet, for this dtype)."""
+    x = _as_kernel_input(data)
+    f = np.asarray(factors, dtype=np.int64).reshape(-1)
+    n = x.shape[0]
+    if n <= SMALL_MAX:
+        return ((small_allan_variance, x),)
+    if type == "mo":
+        return ((small_allan_variance, x), (PARALLEL_KERNEL, np.empty(0)))
+    if f.size and np.all((f & (f - 1)) == 0):
+        return ((HAAR_KERNEL, x.T),)
+    return ((table_task, x), (to_task, x))
 
 
 def allan_variance_columns(data, factors, type: str) -> np.ndarray:

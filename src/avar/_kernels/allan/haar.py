@@ -279,3 +279,8 @@ def haar_sums(data, scale, n_levels, exp=PYRAMID_EXP, chunk=CHUNK_BLOCKS):
     run_tasks(channels * n_tasks, task)
     out = _combine(sums, fh, fl, lh, ll, have, bh, bl, n // block, levels, n_levels)
     return out, big.max(axis=1)
+
+
+#: The compiled loop of :func:`haar_sums`, which reads the data's rows (``data.T``): whether it is
+#: compiled yet, :func:`avar._kernels.runtime.paths.compiled`.
+HAAR_KERNEL = _task

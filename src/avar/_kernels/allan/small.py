@@ -131,3 +131,8 @@ def small_allan_variance_parallel(data, factors, counts, is_mo, integral):
 
         run_tasks(factors.shape[0], task)
     return out
+
+
+#: The compiled loop :func:`small_allan_variance_parallel` adds to the ones it shares with
+#: :func:`small_allan_variance` (whether it is compiled yet: :func:`avar._kernels.runtime.paths.compiled`).
+PARALLEL_KERNEL = _level_task

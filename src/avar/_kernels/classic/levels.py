@@ -29,7 +29,10 @@ Term by term, in O(1) each
   sum built by :func:`detrended_phase` (kind 2);
 * ``code 3``: TOTDEV's second differences of the phase reflected at both ends,
   ``x*_{-j} = 2 x_0 - x_j`` and ``x*_{N-1+j} = 2 x_{N-1} - x_{N-1-j}`` (0-based),
-  evaluated in place without building the 3N-long series.
+  evaluated in place without building the 3N-long series;
+* ``code 4``: MHDEV's window sums ``sum_{i=j}^{j+m-1} (third difference at i)`` are
+  fourth differences ``C[j + 4m] - 4 C[j + 3m] + 6 C[j + 2m] - 4 C[j + m] + C[j]`` of
+  the same running sum ``C`` as code 2.
 
 Terms are split into tasks of a fixed size (a function of the level only), so
 the summation order, and the result, does not depend on the number of threads.
@@ -51,7 +54,7 @@ import numpy as np
 from numba import njit
 
 from avar._kernels.classic.phase import detrended_phase, scan  # noqa: F401 (re-exported)
-from avar._kernels.classic.sums import contiguous_squares, squared_difference_sums
+from avar._kernels.classic.sums import contiguous_squares, difference_kernels, squared_difference_sums
 from avar._kernels.dd import fast_sum
 from avar._kernels.runtime.tasks import run_ranges
 
@@ -83,6 +86,22 @@ def _third(hi, lo, b, m):
 
 
 @njit(cache=True, inline="always")
+def _fourth(hi, lo, b, m):
+    """``P[b + 4m] - 4 P[b + 3m] + 6 P[b + 2m] - 4 P[b + m] + P[b]``: the third difference of the
+    first differences ``P[b + (k + 1) m] - P[b + k m]``, each formed exactly in its double-double parts."""
+    h1 = hi[b + m] - hi[b]
+    h2 = hi[b + 2 * m] - hi[b + m]
+    h3 = hi[b + 3 * m] - hi[b + 2 * m]
+    h4 = hi[b + 4 * m] - hi[b + 3 * m]
+    l1 = lo[b + m] - lo[b]
+    l2 = lo[b + 2 * m] - lo[b + m]
+    l3 = lo[b + 3 * m] - lo[b + 2 * m]
+    l4 = lo[b + 4 * m] - lo[b + 3 * m]
+    return (((h4 - h3) - (h3 - h2)) - ((h3 - h2) - (h2 - h1))) + np.float64(
+        ((l4 - l3) - (l3 - l2)) - ((l3 - l2) - (l2 - l1)))
+
+
+@njit(cache=True, inline="always")
 def _reflected_minus(hi, lo, j, i, last):
     """``P*[j] - P[i]`` with ``P*`` the phase reflected at both ends (0-based, ``last = N - 1``)."""
     if j < 0:  # P*[j] = 2 P[0] - P[-j]
@@ -111,6 +130,8 @@ def _valid(code, bad, mode, b, m, last):
     """Whether term ``b`` of a level avoids every gap (see the module notes)."""
     if code == 2:
         return _range_ok(bad, mode, b, b + 3 * m - 1)
+    if code == 4:
+        return _range_ok(bad, mode, b, b + 4 * m - 1)
     if code == 3:
         low = b - m
         high = b + m
@@ -228,7 +249,12 @@ def _fast_task_sum(hi, lo, code, m, stride, first, last_term, buffer):
         return total
     for start in range(first, last_term, BLOCK):
         count = min(BLOCK, last_term - start)
-        if stride == 1:
+        if code == 4:
+            for j in range(count):
+                d = _fourth(hi, lo, start + j, m)
+                buffer[j] = d * d
+            total += fast_sum(buffer, count)
+        elif stride == 1:
             if code == 0:
                 total += contiguous_squares(hi, lo, m, start, count, buffer)
             else:
@@ -261,6 +287,8 @@ def _task_sum(hi, lo, code, m, stride, first, last_term, mode, bad, buffer):
                 d = _third(hi, lo, k * stride, m)
             elif code == 2:
                 d = _third(hi, lo, k, m)
+            elif code == 4:
+                d = _fourth(hi, lo, k, m)
             else:
                 d = _totdev_term(hi, lo, k, m, last)
             if not _valid(code, bad, mode, k * stride, m, last):
@@ -305,7 +333,7 @@ def level_sums(hi, lo, code, factors, strides, firsts, lasts, mode=0, bad=None, 
     ----------
     hi, lo : float64 and float32 arrays of length N, the phase from :func:`detrended_phase`.
     code : int
-        0 second differences, 1 third differences, 2 MDEV, 3 TOTDEV.
+        0 second differences, 1 third differences, 2 MDEV, 3 TOTDEV, 4 MHDEV.
     factors, strides, firsts, lasts : int64 arrays, one entry per level
         Averaging factor, stride between terms, and the range of term indices.
     mode, bad : gaps, see the module notes (``bad`` unused when ``mode`` is 0).
@@ -338,3 +366,11 @@ def level_sums(hi, lo, code, factors, strides, firsts, lasts, mode=0, bad=None, 
         np.bincount(level, weights=sums, minlength=n_levels),
         np.bincount(level, weights=counts, minlength=n_levels).astype(np.int64),
     )
+
+
+def level_kernels(code, strides, mode=0):
+    """The compiled loops :func:`level_sums` runs for levels of these strides (whether they are
+    compiled yet: :func:`avar._kernels.runtime.paths.compiled`)."""
+    if code == 0 and mode == 0:
+        return difference_kernels(strides, len(strides))
+    return (_task_range,)

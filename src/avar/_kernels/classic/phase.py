@@ -14,6 +14,7 @@ from numba import njit
 
 from avar._kernels.classic.sums import CUMSUM_BLOCK
 from avar._kernels.dd import two_sum
+from avar._kernels.runtime.paths import numpy_path
 from avar._kernels.runtime.tasks import run_tasks
 
 
@@ -77,11 +78,33 @@ def _scan_task(data, b, block, weigh, half, nans, sums, lows, highs, moments):
         nans[b], sums[b], lows[b], highs[b] = _scan_block(data, start, stop)
 
 
+#: Records of at most this many values are scanned by NumPy while the scan's kernels are not
+#: compiled yet (:func:`avar._kernels.runtime.paths.numpy_path`): a few passes, still far shorter
+#: than the compilation.
+NUMPY_SCAN = 1 << 20
+
+
+def _numpy_scan(data, weigh):
+    """:func:`scan` by NumPy (a pairwise sum: as exact as the blocked one)."""
+    missing = np.isnan(data)
+    count = int(np.count_nonzero(missing))
+    values = data[~missing] if count else data
+    if values.shape[0] == 0:
+        return count, 0.0, np.inf, -np.inf, np.nan
+    moment = np.nan
+    if weigh and count == 0:
+        moment = float(np.einsum("i,i", np.arange(data.shape[0], dtype=np.float64) - (data.shape[0] - 1) / 2.0, data))
+    return count, float(np.sum(values)), float(np.min(values)), float(np.max(values)), moment
+
+
 def scan(data, block=CUMSUM_BLOCK, weigh=False):
     """Number of NaN, and sum, minimum and maximum of the other values, in one pass on the threads;
     with ``weigh`` and no NaN, also the centred moment ``sum_i (i - (N - 1) / 2) data_i``
-    (the numerator of the least-squares slope; NaN otherwise)."""
+    (the numerator of the least-squares slope; NaN otherwise). Short records by NumPy while
+    the kernels are cold (:data:`NUMPY_SCAN`)."""
     n = data.shape[0]
+    if numpy_path(n, NUMPY_SCAN, (_scan_task,)):
+        return _numpy_scan(data, weigh)
     n_blocks = -(-n // block)
     nans = np.zeros(n_blocks, dtype=np.int64)
     sums, lows, highs, moments = np.zeros(n_blocks), np.full(n_blocks, np.inf), np.full(n_blocks, -np.inf), \
@@ -190,10 +213,14 @@ def _centred_moment_block(data, kind, start, stop, half):
 def centred_moment(data, kind, block=CUMSUM_BLOCK):
     """sum_i (i - (M - 1) / 2) increment_i over the M increments (``kind`` 0: ``data`` itself; 1: its differences).
 
-    Blocks on the threads, added in order: the bits do not depend on the thread count.
+    Blocks on the threads, added in order: the bits do not depend on the thread count. Short
+    records by NumPy while the kernel is cold (:data:`NUMPY_SCAN`).
     """
     count = data.shape[0] - kind
     half = (count - 1) / 2.0
+    if numpy_path(count, NUMPY_SCAN, (_centred_moment_block,)):
+        increments = data[1:] - data[:-1] if kind == 1 else data
+        return float(np.einsum("i,i", np.arange(count, dtype=np.float64) - half, increments))
     n_blocks = -(-count // block)
     parts = np.zeros(max(n_blocks, 1))
 
@@ -205,3 +232,7 @@ def centred_moment(data, kind, block=CUMSUM_BLOCK):
     for b in range(n_blocks):
         total += float(parts[b])
     return total
+
+
+#: The compiled loop of :func:`detrended_phase` (whether it is compiled yet: :func:`avar._kernels.runtime.paths.compiled`).
+PHASE_KERNELS = (_phase_block,)

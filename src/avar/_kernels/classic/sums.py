@@ -287,3 +287,11 @@ def squared_difference_sums(hi, lo, factors, strides, n_differences, chunk=CHUNK
     level = np.tile(np.arange(n_levels), n_channels)
     sums = _level_wise_sums(hi, lo, channel, factors[level], strides[level], n_differences[level], chunk)
     return sums.reshape(n_channels, n_levels)
+
+
+def difference_kernels(strides, n_levels):
+    """The compiled loops :func:`squared_difference_sums` runs for ``n_levels`` levels of these
+    strides (whether they are compiled yet: :func:`avar._kernels.runtime.paths.compiled`)."""
+    if np.all(np.asarray(strides) == 1) and n_levels <= FUSED_MAX_LEVELS:
+        return (_fused_block,)
+    return (_task_range,)

@@ -80,8 +80,9 @@ def configure(folder: Path = KERNELS, environ: MutableMapping[str, str] = os.env
     return chosen
 
 
-def cached_for_this_machine(dispatcher) -> bool:
-    """Whether numba's cache holds code of ``dispatcher`` compiled for this CPU and source.
+def cached_for_this_machine(dispatcher, first=None) -> bool:
+    """Whether numba's cache holds code of ``dispatcher`` compiled for this CPU and source
+    (with ``first``, a numba type, as the type of its first argument).
 
     Reads the kernel's cache index (numba returns it empty when missing or stale) and
     looks for an entry whose code-generation key (CPU name and features) is this
@@ -89,6 +90,7 @@ def cached_for_this_machine(dispatcher) -> bool:
     """
     try:
         magic = dispatcher.targetctx.codegen().magic_tuple()
-        return any(key[1] == magic for key in dispatcher._cache._cache_file._load_index())
+        return any(key[1] == magic and (first is None or key[0][0] == first)
+                   for key in dispatcher._cache._cache_file._load_index())
     except Exception:  # numba internals changed: assume nothing is cached
         return False

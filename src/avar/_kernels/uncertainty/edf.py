@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from avar._kernels.runtime.paths import numpy_path
+
 #: C(2d, d + k) for d = 1, 2, 3 and k = -d .. d (row d, column d + k).
 _BINOMIAL = np.array([[0, 0, 0, 0, 0, 0, 0], [1, 2, 1, 0, 0, 0, 0], [1, 4, 6, 4, 1, 0, 0], [1, 6, 15, 20, 15, 6, 1]],
                      dtype=np.float64)
@@ -83,8 +85,10 @@ def basic_sums(j, m, s, f, alpha, d, norm, denominator, out):
 
 
 #: Up to this many rows :func:`greenhall_sums` takes NumPy's sums (nothing to compile;
-#: a noise report's levels); more rows (every tau of a long series) the compiled loops.
+#: a noise report's levels); more rows (every tau of a long series) the compiled loops, or
+#: NumPy's up to NUMPY_COLD_ROWS while they are not compiled yet (:mod:`avar._kernels.runtime.paths`).
 NUMPY_ROWS = 256
+NUMPY_COLD_ROWS = 1 << 14
 
 
 def _numpy_sw(t, alpha):
@@ -112,8 +116,9 @@ def _numpy_sz(t, f, alpha, d):
 
 def greenhall_sums(j, m, s, f, alpha, d, norm, denominator):
     """:func:`basic_sums` of every row, returned: in NumPy for at most :data:`NUMPY_ROWS`
-    rows (at most J_max + 1 lags each), else by the compiled loops."""
-    if j.shape[0] > NUMPY_ROWS:
+    rows (at most J_max + 1 lags each; up to :data:`NUMPY_COLD_ROWS` while the loops are not
+    compiled yet), else by the compiled loops."""
+    if j.shape[0] > NUMPY_ROWS and not numpy_path(j.shape[0], NUMPY_COLD_ROWS, (basic_sums,)):
         out = np.empty(j.shape[0])
         basic_sums(j, m, s, f, alpha, d, norm, denominator, out)
         return out

@@ -175,6 +175,12 @@ def _decimating_levels(x, factors, dmax, line, out):
         out[i] = lag1_alpha_decimated(buffer[:length], 1, dmax, line * m)
 
 
+def lag1_kernels(n_levels):
+    """The compiled loops :func:`lag1_levels_split` (several levels) or :func:`lag1_levels` (one)
+    runs (whether they are compiled yet: :func:`avar._kernels.runtime.paths.compiled`)."""
+    return (lag1_alpha_decimated, _decimating_levels) if n_levels > 1 else (lag1_levels,)
+
+
 @njit(cache=True, nogil=True, fastmath=_FAST)
 def running_sum(x, drift, step, out):
     """R(n)'s running sum of the phase ``x_i + drift i (i - 1) / 2`` at every ``step``-th index:

@@ -3,7 +3,8 @@
 * :mod:`avar.fit.gmwm.estimator`: :func:`gmwm` and the fit of one Allan variance;
 * :mod:`avar.fit.gmwm.model`: which processes, their parameters and transforms;
 * :mod:`avar.fit.gmwm.objective`, :mod:`~avar.fit.gmwm.implied`: objective, weights, optimizer, implied AV;
-* :mod:`avar.fit.gmwm.covariance`, :mod:`~avar.fit.gmwm.bootstrap`: covariance of the AV estimates, bootstraps;
+* :mod:`~avar.fit.gmwm.bootstrap`: bootstraps (the exact covariance of the AV estimates of ``weights="efficient"``
+  is :mod:`avar.fit.covariance.exact`);
 * :mod:`avar.fit.gmwm.results`: :class:`GmwmResult`, :class:`ImuGmwmResult`;
 * :mod:`avar.fit.gmwm.selection`: :func:`select_model`.
 """

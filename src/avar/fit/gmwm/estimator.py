@@ -72,7 +72,7 @@ def gmwm(
         simulating 200 series. ``"efficient"``: W the inverse of the exact
         Gaussian covariance of nu_hat at theta_1, computed from the
         autocovariance of the first differences
-        (:mod:`avar.fit.gmwm.covariance`; "mo" AV of WN, QN, RW, DR and AR1
+        (:mod:`avar.fit.covariance.exact`; "mo" AV of WN, QN, RW, DR and AR1
         only): the asymptotically optimal weighting, without simulation.
         ``"identity"``: unweighted on the log scale.
     ci : bool
@@ -176,12 +176,12 @@ def fit_allan_variance(
     rng = np.random.default_rng(seed)
     covariance = None
     if weights == "efficient":
-        from avar.fit.gmwm.covariance import check_supported, mo_av_covariance
+        from avar.fit.covariance.exact import exact_covariance
 
-        check_supported(spec.classes, av.type)
+        check_efficient(spec, av.type)
 
         def covariance(theta: np.ndarray) -> np.ndarray:
-            return mo_av_covariance(spec.model(theta), av.n, factors)
+            return exact_covariance(spec.model(theta), av.n, factors)
     elif weights == "full":
         from avar.fit.gmwm.bootstrap import av_covariance
 
@@ -204,6 +204,21 @@ def fit_allan_variance(
         objective=fit.objective, weights=weights, ci=table, confidence=confidence if ci else None,
         replicates=replicates if ci else None, converged=fit.converged,
     )
+
+
+def check_efficient(spec: ModelSpec, type: str) -> None:
+    """Raise ValueError unless the AV is "mo" and every process has an exact covariance
+    (:data:`avar.fit.covariance.exact.SUPPORTED`)."""
+    from avar.fit.covariance.exact import SUPPORTED
+
+    if type != "mo":
+        raise ValueError(f"weights='efficient' needs a maximal-overlap ('mo') Allan variance, got type {type!r}; "
+                         "use weights='full' or 'diagonal'")
+    unknown = [cls.name for cls in spec.classes if not issubclass(cls, SUPPORTED)]
+    if unknown:
+        names = [cls.name for cls in SUPPORTED]
+        raise ValueError(f"weights='efficient' supports {', '.join(names[:-1])} and {names[-1]}, not {unknown}; "
+                         "use weights='full'")
 
 
 def _imu_gmwm(x: Any, models: dict[str, Any], taus: Any, seed: Any, options: dict[str, Any]) -> ImuGmwmResult:

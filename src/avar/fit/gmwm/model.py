@@ -26,9 +26,11 @@ from typing import Any
 
 import numpy as np
 
-from avar.models import NoiseModel, Process
+from avar.fit.slopes import PROCESS_CLASSES
+from avar.models import AR1, NoiseModel, Process
+from avar.models.base import process_classes
 
-__all__ = ["ModelSpec", "parse_model", "process_classes", "TRANSFORMS", "continuous_parameters"]
+__all__ = ["ModelSpec", "parse_model", "TRANSFORMS", "continuous_parameters"]
 
 #: Clip of the unconstrained values: exp(+-300) stays finite, tanh(+-17) stays inside (-1, 1).
 _LOG_CLIP, _TANH_CLIP = 300.0, 17.0
@@ -65,17 +67,6 @@ POSITIVE = Transform("log")
 def transform_of(field_name: str) -> Transform:
     """The transform of a parameter field: ``phi`` atanh, anything else log."""
     return TRANSFORMS.get(field_name, POSITIVE)
-
-
-def process_classes() -> dict[str, type[Process]]:
-    """Every named :class:`Process` subclass defined so far, by upper-case name."""
-    found, pending = {}, list(Process.__subclasses__())
-    while pending:
-        cls = pending.pop()
-        pending.extend(cls.__subclasses__())
-        if cls.name:
-            found[cls.name.upper()] = cls
-    return found
 
 
 @dataclass(frozen=True)
@@ -221,7 +212,9 @@ def continuous_parameters(process: Process, freq: float) -> dict[str, float]:
     """Continuous-time parameters of a per-sample process at rate ``freq`` (Hz).
 
     WN sigma = sqrt(sigma2 / f) [u s^1/2]; QN Q = sqrt(q2) / f [u s]; RW
-    gamma = sqrt(gamma2 f) [u s^-1/2]; DR omega f [u s^-1]; AR1 (a first-order
+    gamma = sqrt(gamma2 f) [u s^-1/2]; DR omega f [u s^-1] (the class's
+    ``coefficient`` and ``coefficient_label``, for the processes of
+    :data:`avar.fit.slopes.PROCESS_CLASSES`); AR1 (a first-order
     Gauss-Markov process) correlation time T = -1 / (f ln phi) [s] (for
     phi > 0) and stationary deviation sqrt(sigma2 / (1 - phi^2)) [u]. The
     inverses of the ``from_continuous`` constructors. Other processes: {}.
@@ -230,18 +223,11 @@ def continuous_parameters(process: Process, freq: float) -> dict[str, float]:
     >>> continuous_parameters(WN(sigma2=4.0), 100.0)
     {'sigma [u s^1/2]': 0.2}
     """
-    values = process.parameters
-    name = process.name
-    if name == "WN":
-        return {"sigma [u s^1/2]": float(np.sqrt(values["sigma2"] / freq))}
-    if name == "QN":
-        return {"Q [u s]": float(np.sqrt(values["q2"]) / freq)}
-    if name == "RW":
-        return {"gamma [u s^-1/2]": float(np.sqrt(values["gamma2"] * freq))}
-    if name == "DR":
-        return {"omega [u s^-1]": float(abs(values["omega"]) * freq)}
-    if name == "AR1":
-        phi = values["phi"]
+    cls = type(process)
+    if cls in PROCESS_CLASSES.values():
+        return {cls.coefficient_label: float(cls.coefficient(process.scale, freq))}
+    if isinstance(process, AR1):
+        phi = process.phi
         corr = -1.0 / (freq * np.log(phi)) if 0.0 < phi < 1.0 else float("nan")
-        return {"T [s]": float(corr), "sigma_s [u]": float(np.sqrt(values["sigma2"] / (1.0 - phi**2)))}
+        return {"T [s]": float(corr), "sigma_s [u]": float(np.sqrt(process.sigma2 / (1.0 - phi**2)))}
     return {}

@@ -23,7 +23,7 @@ It runs in two steps, each a Levenberg-Marquardt least-squares fit
    inverse of a covariance matrix of nu_hat (from a short parametric
    bootstrap at theta_1, see :mod:`avar.fit.gmwm.bootstrap`); ``"efficient"``:
    W the inverse of the exact Gaussian covariance of nu_hat at theta_1
-   (:mod:`avar.fit.gmwm.covariance`), the optimal GMM weight.
+   (:mod:`avar.fit.covariance.exact`), the optimal GMM weight.
    ``"identity"``: step 1 alone, with edf_j = 2 (unweighted log scale).
 
 Starting values: each process whose values are not given starts on the

@@ -10,12 +10,13 @@ Each function returns warning texts (empty when all is well); none prints.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from avar.fit.report.noise_terms import ACCEL, GYRO, GYRO_UNITS
 
-__all__ = ["fit_check", "unit_warnings", "data_warnings", "FIT_TOLERANCE", "FIT_SHARE", "OUTLIER_MAD"]
+__all__ = ["FitCheck", "fit_check", "unit_warnings", "data_warnings", "FIT_TOLERANCE", "FIT_SHARE", "OUTLIER_MAD"]
 
 #: A level fits when the implied deviation is inside the band or within this relative distance.
 FIT_TOLERANCE = 0.10
@@ -32,8 +33,15 @@ MOVING_RATIO = 100.0
 G0 = 9.80665
 
 
+class FitCheck(NamedTuple):
+    """Which levels fit (``fits``), and the ``warning`` when fewer than :data:`FIT_SHARE` do (else None)."""
+
+    fits: np.ndarray
+    warning: str | None
+
+
 def fit_check(channel: str, tau: np.ndarray, adev: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-              implied: np.ndarray) -> tuple[np.ndarray, str | None]:
+              implied: np.ndarray) -> FitCheck:
     """Which levels fit, and a warning when fewer than 90 % do.
 
     >>> tau = np.array([1.0, 2.0, 4.0])
@@ -44,12 +52,12 @@ def fit_check(channel: str, tau: np.ndarray, adev: np.ndarray, lower: np.ndarray
     ratio = implied / adev
     fits = ((implied >= lower) & (implied <= upper)) | (np.abs(ratio - 1.0) <= FIT_TOLERANCE)
     if fits.mean() >= FIT_SHARE:
-        return fits, None
+        return FitCheck(fits, None)
     bad = np.flatnonzero(~fits)
     shown = ", ".join(f"{tau[j]:.3g} s: {100 * (ratio[j] - 1):+.0f} %" for j in bad[:4])
     more = f" and {bad.size - 4} more" if bad.size > 4 else ""
-    return fits, (f"{channel}: the fitted model departs from the Allan deviation at {bad.size} of {tau.size} levels "
-                  f"(tau {shown}{more})")
+    return FitCheck(fits, f"{channel}: the fitted model departs from the Allan deviation at {bad.size} of {tau.size} "
+                          f"levels (tau {shown}{more})")
 
 
 def unit_warnings(channel: str, kind: str | None, unit: str, values: np.ndarray, white_density: float | None,

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from avar._escape import yaml_comment, yaml_entry
 from avar.fit.report.noise_terms import ACCEL, GYRO
 
 __all__ = ["kalibr_fields", "kalibr_notes", "kalibr_text", "write_kalibr", "axis_values", "nominal_rate",
@@ -149,17 +150,19 @@ def kalibr_notes(report: Any, axis: str = "max", **given: float) -> dict[str, st
 
 
 def kalibr_text(report: Any, axis: str = "max", **overrides: Any) -> str:
-    """The ``imu.yaml`` text: every field on its line, each density with its comment."""
-    import yaml
+    """The ``imu.yaml`` text: every field on its line, each density with its comment.
 
+    Names from the data (the report's name, channels, the topic) go through the YAML escapes of
+    :mod:`avar._escape`: a comment stays one line, a value is quoted, so the file holds these keys
+    and no other whatever the names hold."""
     fields = kalibr_fields(report, axis=axis, **overrides)
     notes = kalibr_notes(report, axis=axis, **{k: v for k, v in overrides.items() if k in FIELDS.values()})
     source = getattr(report, "name", None) or "a noise report"
-    lines = [f"# IMU noise model written by avar from {source}: Kalibr's continuous-time densities (SI)"]
+    lines = [yaml_comment(f"IMU noise model written by avar from {source}: Kalibr's continuous-time densities (SI)")]
     for key, value in fields.items():
         if key in notes:
-            lines.append(f"# {notes[key]}")
-        lines.append(yaml.safe_dump({key: value}, default_flow_style=False).strip())
+            lines.append(yaml_comment(notes[key]))
+        lines.append(yaml_entry(key, value))
     return "\n".join(lines) + "\n"
 
 

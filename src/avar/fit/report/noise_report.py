@@ -13,7 +13,7 @@ The result is a :class:`~avar.fit.report.result.NoiseReport`.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -32,7 +32,7 @@ from avar.recording import Recording
 from avar.stability.allan.estimator import avar as allan_variance
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 
-__all__ = ["noise_report", "infer_sensor_type", "fit_channel"]
+__all__ = ["noise_report", "infer_sensor_type", "fit_channel", "FittedChannel"]
 
 DEFAULT_UNITS = {GYRO: "rad/s", ACCEL: "m/s^2"}
 
@@ -138,7 +138,15 @@ def _channels(x: Any, rate: Any, gyro: Any, accel: Any, taus: Any, type: str, si
     return [(str(name) if name is not None else "x", single_kind, av, series)], None, None
 
 
-def fit_channel(av: AllanVariance, significance: float) -> tuple[SensorFit, np.ndarray, np.ndarray]:
+class FittedChannel(NamedTuple):
+    """The selected model of one channel and the band of its Allan deviation (``lower``, ``upper``)."""
+
+    fit: SensorFit
+    lower: np.ndarray
+    upper: np.ndarray
+
+
+def fit_channel(av: AllanVariance, significance: float) -> FittedChannel:
     """The selected model of one Allan variance and its band of confidence 1 - significance (lower, upper deviation).
 
     The fit weighs the levels by their degrees of freedom (N - 2m + 1) / m;
@@ -160,14 +168,14 @@ def fit_channel(av: AllanVariance, significance: float) -> tuple[SensorFit, np.n
     lower, upper, edf = _band(av, fit.implied(factors), significance)
 
     def share(implied: np.ndarray) -> float:
-        return float(np.mean(fit_check("", av.levels, adev, lower, upper, np.sqrt(implied))[0]))
+        return float(np.mean(fit_check("", av.levels, adev, lower, upper, np.sqrt(implied)).fits))
 
     if share(fit.implied(factors)) < FIT_SHARE:
         fit = fit_sensor_model(factors, nu_hat, counts / factors, check=share)
         lower, upper, edf = _band(av, fit.implied(factors), significance)
     if av.type != "mo":  # the exact covariance is the maximal-overlap estimator's
-        return non_overlapping_fit(fit, av.n, 2.0 * fit.implied(factors) ** 2 / edf), lower, upper
-    return with_level_covariance(fit, av.n), lower, upper
+        return FittedChannel(non_overlapping_fit(fit, av.n, 2.0 * fit.implied(factors) ** 2 / edf), lower, upper)
+    return FittedChannel(with_level_covariance(fit, av.n), lower, upper)
 
 
 def _band(av: AllanVariance, implied: np.ndarray, significance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -26,9 +26,10 @@ IEEE Std 952-1997, Annex C; IEEE Std 1554-2005.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 __all__ = ["GYRO_UNITS", "ACCEL_UNITS", "UNIT_SPELLINGS", "TERM_NAMES", "SI_UNITS", "CUSTOMARY", "check_unit", "to_si",
-           "customary", "unit_of"]
+           "Customary", "customary", "unit_of"]
 
 G0 = 9.80665
 DEG = math.pi / 180.0
@@ -101,7 +102,14 @@ def to_si(value: float, sensor_type: str | None, unit: str | None) -> float:
     return value * table[unit]
 
 
-def customary(term: str, si_value: float, sensor_type: str | None) -> tuple[float, str] | None:
+class Customary(NamedTuple):
+    """A coefficient in customary units: its ``value`` and ``unit``."""
+
+    value: float
+    unit: str
+
+
+def customary(term: str, si_value: float, sensor_type: str | None) -> Customary | None:
     """The customary value and unit of an SI coefficient, or None for an unknown sensor type.
 
     >>> value, unit = customary("WN", 1e-4 * math.pi / 180, "Gyroscope")  # 1e-4 deg/s/sqrt(Hz)
@@ -111,7 +119,7 @@ def customary(term: str, si_value: float, sensor_type: str | None) -> tuple[floa
     if sensor_type not in CUSTOMARY:
         return None
     unit, factor = CUSTOMARY[sensor_type][term]
-    return si_value * factor, unit
+    return Customary(si_value * factor, unit)
 
 
 def unit_of(term: str, sensor_type: str | None, data_unit: str | None) -> str:

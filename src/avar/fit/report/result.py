@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from avar._escape import html_text, terminal
 from avar._frozen import frozen_mapping
 from avar._vocabulary import deprecated_significance
 from avar.stability.allan.results import format_frequency
@@ -175,18 +176,18 @@ class NoiseReport:
         return plot_report(self, **kwargs)
 
     def describe(self) -> str:
-        where = f" ({self.topic})" if self.topic else ""
-        return (f"Noise report of {self.name}{where}: {len(self.channels)} channel(s), N = {self.n_samples}, "
+        where = f" ({terminal(self.topic)})" if self.topic else ""  # names from data: shown, never obeyed
+        return (f"Noise report of {terminal(self.name)}{where}: {len(self.channels)} channel(s), N = {self.n_samples}, "
                 f"freq = {format_frequency(self.rate)}, {100 * self.confidence:g}% chi-squared intervals")
 
     def __str__(self) -> str:
         lines = [self.describe()]
         for channel, kind in zip(self.channels, self.sensor_types):
-            lines.append(f"\n{channel}" + (f" ({kind.lower()})" if kind else ""))
+            lines.append(f"\n{terminal(channel)}" + (f" ({kind.lower()})" if kind else ""))
             rows = self.terms[self.terms["Channel"] == channel]
             for _, row in rows.iterrows():
                 if row["Status"] == "warning":
-                    lines.append(f"  warning: {row['Note']}")
+                    lines.append(f"  warning: {terminal(row['Note'])}")
                     continue
                 if row["Status"] == "absent":
                     lines.append(f"  {row['Term']:<34} absent")
@@ -210,4 +211,4 @@ class NoiseReport:
         return f"<NoiseReport {self.describe()}>"
 
     def _repr_html_(self) -> str:
-        return f"<p>{self.describe()}</p>" + self.table.to_html(index=False)
+        return f"<p>{html_text(self.describe())}</p>" + self.table.to_html(index=False)  # to_html escapes

@@ -33,6 +33,7 @@ import pandas as pd
 
 from avar.fit.report.noise_terms import ACCEL, GYRO, TERM_NAMES, customary, to_si, unit_of
 from avar.fit.report.sensor_fit import SensorFit, term_bound
+from avar.fit.terms import POWER_LAWS
 
 __all__ = ["channel_rows", "minimum_row", "BOUNDED", "ROW_COLUMNS"]
 
@@ -40,13 +41,8 @@ __all__ = ["channel_rows", "minimum_row", "BOUNDED", "ROW_COLUMNS"]
 BOUNDED = ("WN", "FN", "RW")
 ROW_COLUMNS = ["Channel", "Sensor", "Term", "Process", "Status", "Value", "Lower", "Upper", "Unit", "Customary",
                "Customary lower", "Customary upper", "Customary unit", "Tau (s)", "Note"]
-CONVERSIONS = {
-    "QN": lambda c, f: math.sqrt(c) / f,
-    "WN": lambda c, f: math.sqrt(c / f),
-    "FN": lambda c, f: math.sqrt(c),
-    "RW": lambda c, f: math.sqrt(c * f),
-    "DR": lambda c, f: math.sqrt(c) * f,
-}
+#: The coefficient of each IEEE term from its per-sample variance c at f Hz (the process class's ``coefficient``).
+CONVERSIONS = {cls.name: cls.coefficient for cls in POWER_LAWS}
 DEG = math.pi / 180.0
 G0 = 9.80665
 
@@ -74,8 +70,8 @@ def _ieee_row(channel: str, kind: str | None, unit: str | None, process: str, st
     si = tuple(pd.NA if v is pd.NA else to_si(v, kind, unit) for v in values)
     custom, custom_unit = (pd.NA,) * 3, ""
     if kind in (GYRO, ACCEL):
-        custom_unit = customary(process, 1.0, kind)[1]
-        custom = tuple(pd.NA if v is pd.NA else customary(process, v, kind)[0] for v in si)
+        custom_unit = customary(process, 1.0, kind).unit
+        custom = tuple(pd.NA if v is pd.NA else customary(process, v, kind).value for v in si)
     name = TERM_NAMES[kind][process]
     if process == "FN":
         name += " B (AD = 0.664 B)"  # IEEE 952's convention, stated
@@ -89,8 +85,7 @@ def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFi
     by_kind: dict[str, list[int]] = {}
     for k, component in enumerate(fit.components):
         by_kind.setdefault(component.kind, []).append(k)
-    for process in ("QN", "WN", "FN", "RW", "DR"):
-        convert = CONVERSIONS[process]
+    for process, convert in CONVERSIONS.items():
         if process in by_kind:
             k = by_kind[process][0]
             c = fit.components[k].scale

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avar.fit.report.sensor_terms import Component, basis
+from avar.fit.terms import Component, basis
 
 __all__ = ["jacobian", "parameter_covariance", "independent_levels"]
 

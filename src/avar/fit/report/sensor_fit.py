@@ -57,7 +57,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from avar.fit.report.sandwich import independent_levels, parameter_covariance
-from avar.fit.report.sensor_terms import KINDS, LINEAR, Component, basis, deviance, weight_edf
+from avar.fit.report.sensor_terms import KINDS, LINEAR, deviance, weight_edf
+from avar.fit.terms import Component, basis
 
 __all__ = ["SensorFit", "fit_sensor_model", "term_bound"]
 

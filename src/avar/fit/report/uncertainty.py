@@ -6,7 +6,7 @@ walk's last octaves are 80 % correlated), and where terms mix, one power law
 per level misstates their variances too. The parameters' covariance is
 therefore the sandwich (:mod:`avar.fit.report.sandwich`) of the fit's weights
 around S, the exact covariance of the maximal-overlap estimates under the
-selected model itself (:func:`~avar.fit.report.level_covariance.level_covariance`).
+selected model itself (:func:`~avar.fit.covariance.structure.structure_covariance`).
 
 A generalized-least-squares refit with weights S^-1 (the GMWM's efficient
 step) was tried and not kept: on 100 simulated 2 h gyros it moved the median
@@ -20,22 +20,24 @@ import dataclasses
 
 import numpy as np
 
-from avar.fit.report.level_covariance import level_covariance
+from avar.fit.covariance.structure import ACCURACY, structure_covariance
 from avar.fit.report.sandwich import parameter_covariance
 from avar.fit.report.sensor_fit import SensorFit
-from avar.fit.report.sensor_terms import Component, weight_edf
+from avar.fit.report.sensor_terms import weight_edf
+from avar.fit.terms import Component
 
 __all__ = ["with_level_covariance", "non_overlapping_fit", "model_levels", "EIGEN_FLOOR"]
 
 #: Smallest eigenvalue kept in the levels' correlation: the sums over lags are exact to about
-#: 1e-3, so a direction of smaller variance is not known to exist and must not be trusted.
-EIGEN_FLOOR = 1e-3
+#: 1e-3 (:data:`~avar.fit.covariance.structure.ACCURACY`), so a direction of smaller variance is
+#: not known to exist and must not be trusted.
+EIGEN_FLOOR = ACCURACY
 
 
 def model_levels(components: tuple[Component, ...], n: int, factors: np.ndarray) -> np.ndarray:
     """The maximal-overlap estimates' covariance under ``components``, its correlation's eigenvalues
     raised to :data:`EIGEN_FLOOR` (the variances kept)."""
-    levels = level_covariance(components, n, factors)
+    levels = structure_covariance(components, n, factors)
     spread = np.sqrt(np.diag(levels))
     values, vectors = np.linalg.eigh(levels / np.outer(spread, spread))
     correlation = (vectors * np.maximum(values, EIGEN_FLOOR)) @ vectors.T

@@ -17,6 +17,7 @@ import numpy as np
 if TYPE_CHECKING:  # pandas loads with the first table
     import pandas as pd
 
+from avar._escape import html_text, terminal
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
 from avar.stability.shared.confidence import format_confidence
@@ -187,7 +188,7 @@ class AllanVariance:
 
     def describe(self) -> str:
         """One line: estimator, length, rate and number of levels."""
-        label = f"{self.name}: " if self.name else ""
+        label = f"{terminal(self.name)}: " if self.name else ""  # a name from data: shown, never obeyed
         return (
             f"{label}Allan variance ({TYPE_NAMES.get(self.type, self.type)}, type {self.type!r}), "
             f"N = {self.n}, freq = {format_frequency(self.freq)}, {len(self)} levels"
@@ -206,7 +207,7 @@ class AllanVariance:
         return f"<AllanVariance {self.describe()}>"
 
     def _repr_html_(self) -> str:
-        return f"<p>{self.describe()}</p>" + self.summary().to_html(index=False)
+        return f"<p>{html_text(self.describe())}</p>" + self.summary().to_html(index=False)
 
     def plot(self, **kwargs: Any):
         """Log-log plot of the Allan variance; see :func:`avar.plotting.plot_avar`."""
@@ -301,21 +302,21 @@ class ImuAllanVariance:
 
     def describe(self) -> str:
         return (
-            f"{self.sensor} @ {format_frequency(self.freq)}, N = {self.n}, "
-            f"{len(self)} channels ({', '.join(self.channels)})"
+            f"{terminal(self.sensor)} @ {format_frequency(self.freq)}, N = {self.n}, "
+            f"{len(self)} channels ({', '.join(map(terminal, self.channels))})"
         )
 
     def __str__(self) -> str:
         lines = [f"IMU Allan variance: {self.describe()}"]
         for (name, av), kind, axis in zip(self.channels.items(), self.sensor_types, self.axes):
-            lines.append(f"  {name:<10} {kind:<14} axis {axis}: {len(av)} levels, tau {av.levels[0]:g} .. {av.levels[-1]:g} s")
+            lines.append(f"  {terminal(name):<10} {kind:<14} axis {terminal(axis)}: {len(av)} levels, tau {av.levels[0]:g} .. {av.levels[-1]:g} s")
         return "\n".join(lines)
 
     def __repr__(self) -> str:
         return f"<ImuAllanVariance {self.describe()}>"
 
     def _repr_html_(self) -> str:
-        return f"<p>IMU Allan variance: {self.describe()}</p>" + self.summary().to_html()
+        return f"<p>IMU Allan variance: {html_text(self.describe())}</p>" + self.summary().to_html()
 
     def plot(self, **kwargs: Any):
         """Grid of log-log Allan deviation plots; see :func:`avar.plotting.plot_imu_avar`."""

@@ -18,18 +18,33 @@ from typing import NamedTuple
 
 import numpy as np
 
-from avar._kernels.classic.levels import detrended_phase, level_sums, scan
-from avar._kernels.classic.phase import centred_moment
+from avar._kernels.classic.levels import detrended_phase, level_kernels, level_sums, scan
+from avar._kernels.classic.phase import PHASE_KERNELS, centred_moment
 from avar._kernels.classic.pyramid import MOMENTS, SUM_COLUMN, TAIL, octave_moments
-from avar._kernels.uncertainty.noise_id import rn_clusters
+from avar._kernels.runtime.paths import numpy_path
+from avar._kernels.uncertainty.noise_id import lag1_alpha_from_moments, rn_clusters
+from avar.stability.classic.small import level_sums as small_level_sums
 from avar.stability.shared.registry import KERNEL_CODES
 from avar.stability.shared.term_counts import term_counts, term_ranges
 
-#: Denominator constant of every estimator: sigma^2 = sum / (K m^2 tau0^2 n) (MDEV: K m^4 tau0^2 n).
-_K = {"adev": 2.0, "oadev": 2.0, "mdev": 2.0, "tdev": 2.0, "hdev": 6.0, "ohdev": 6.0, "totdev": 2.0}
+#: Denominator constant of every estimator: sigma^2 = sum / (K m^2 tau0^2 n) (MDEV, MHDEV: K m^4 tau0^2 n).
+_K = {"adev": 2.0, "oadev": 2.0, "mdev": 2.0, "tdev": 2.0, "hdev": 6.0, "ohdev": 6.0, "totdev": 2.0,
+      "mhdev": 6.0, "htdev": 6.0}
+#: The estimators blind to a linear frequency drift (the phase parts remove it), and those summed
+#: as differences of the phase's running sum (the modified ones).
+HADAMARD = ("hdev", "ohdev", "mhdev", "htdev")
+MODIFIED = ("mdev", "tdev", "mhdev", "htdev")
+#: The time deviations: tau^2 / TIME_FACTOR times their modified variance (TDEV: 3, HTDEV: 10 / 3).
+TIME_FACTOR = {"tdev": 3.0, "htdev": 10.0 / 3.0}
 
 
 _NO_LO = np.zeros(1, dtype=np.float32)
+#: Gap-free records of at most NUMPY_SAMPLES points whose levels hold at most NUMPY_TERMS terms
+#: in all (plus one per phase point) take the NumPy path while the kernels are cold
+#: (:func:`numpy_levels`): well under the compilation's seconds (0.05 s for the octave levels
+#: of 2**18 points, 0.6 s for TOTDEV's 1e4 levels of 1e4 points); longer records compile, as before.
+NUMPY_SAMPLES = 1 << 18
+NUMPY_TERMS = 1 << 27
 
 
 def _filled(data: np.ndarray, is_phase: bool, n_missing: int) -> tuple[np.ndarray, np.ndarray | None]:
@@ -144,6 +159,38 @@ def _is_octave(factors: np.ndarray) -> bool:
     return bool(factors.size) and bool(np.array_equal(factors, 2 ** np.arange(factors.size, dtype=np.int64)))
 
 
+class PhaseLine(NamedTuple):
+    """What the detrended phase of the data removes, and its scale (:func:`phase_line`)."""
+
+    filled: np.ndarray
+    bad: np.ndarray | None
+    count: int
+    centre: float
+    slope: float
+    scale: float
+
+
+def phase_line(data: np.ndarray, data_type: str, estimator: str, scanned: tuple | None = None) -> PhaseLine:
+    """The data with their gaps filled, the prefix count of gaps (None: no gap), the number of
+    phase increments, and the line ``centre + slope i`` the increments lose (their mean and, for
+    the Hadamard family, their linear drift) before they are scaled by the power of two ``scale``
+    (see :func:`phase_parts`)."""
+    is_phase = data_type == "phase"
+    n_missing, total, low, high, moment = scan(data) if scanned is None else scanned
+    filled, bad = _filled(data, is_phase, n_missing)
+    count = filled.shape[0] - 1 if is_phase else filled.shape[0]
+    slope = 0.0
+    if estimator in HADAMARD:
+        slope = _drift(filled, is_phase, np.nan if is_phase else moment)
+    if is_phase:
+        centre = (filled[-1] - filled[0]) / count - slope * (count - 1) / 2
+        origin = filled[0]
+    else:
+        centre = total / (count - n_missing) - slope * (count - 1) / 2
+        origin = centre
+    return PhaseLine(filled, bad, count, float(centre), slope, _scale(low, high, origin))
+
+
 def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple | None = None) -> PhaseParts:
     """The compensated, detrended, scaled phase of ``data`` and what the kernels need.
 
@@ -152,7 +199,7 @@ def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple
     frequency data) with its mean frequency (and, for HDEV and OHDEV, its
     linear frequency drift) removed, the gap mode and the prefix count of
     gaps (see :mod:`avar._kernels.classic.levels`); then ``phase``, the
-    detrended phase ``hi`` itself (for MDEV, before its running sum),
+    detrended phase ``hi`` itself (for MDEV and MHDEV, before its running sum),
     ``drift``: ``phase`` lacks ``drift * k (k - 1) / 2`` (the Hadamard family's
     removed linear frequency drift), and ``line``: for phase data, ``phase``
     lacks ``line * k`` too (their frequency offset, which Stable32's noise
@@ -160,24 +207,12 @@ def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple
     of ``data`` if already known.
     """
     is_phase = data_type == "phase"
-    n_missing, total, low, high, moment = scan(data) if scanned is None else scanned
-    filled, bad = _filled(data, is_phase, n_missing)
-    count = filled.shape[0] - 1 if is_phase else filled.shape[0]
-    slope = 0.0
-    if estimator in ("hdev", "ohdev"):
-        slope = _drift(filled, is_phase, np.nan if is_phase else moment)
-    if is_phase:
-        centre = (filled[-1] - filled[0]) / count - slope * (count - 1) / 2
-        origin = filled[0]
-    else:
-        centre = total / (count - n_missing) - slope * (count - 1) / 2
-        origin = centre
-    scale = _scale(low, high, origin)
+    filled, bad, count, centre, slope, scale = phase_line(data, data_type, estimator, scanned)
     hi = np.empty(count + 1)
     lo = np.empty(count + 1, dtype=np.float32)
     detrended_phase(filled, _NO_LO, int(is_phase), float(centre), slope, scale, hi, lo)
     phase = hi
-    if estimator in ("mdev", "tdev"):  # MDEV's terms are third differences of the running sum
+    if estimator in MODIFIED:  # MDEV's (MHDEV's) terms are third (fourth) differences of the running sum
         running_hi = np.empty(count + 2)
         running_lo = np.empty(count + 2, dtype=np.float32)
         detrended_phase(hi, lo, 2, float(np.mean(hi)), 0.0, 1.0, running_hi, running_lo)
@@ -193,7 +228,7 @@ def deviation_levels(
 
     Parameters
     ----------
-    estimator : {"adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev"}
+    estimator : {"adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "mhdev", "htdev"}
     data : float64 ndarray
         Phase (s) or fractional frequency; NaN marks a gap, and the terms
         that touch one are skipped (see :mod:`avar._kernels.classic.levels`).
@@ -235,21 +270,80 @@ def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.nda
     factors = np.asarray(factors, dtype=np.int64)
     n_phase = data.shape[0] + (data_type == "freq")
     scanned = scan(data) if scanned is None else scanned
-    if estimator in ("adev", "hdev") and data_type == "freq" and scanned[0] == 0 and _is_octave(factors):
+    small = numpy_levels(estimator, data, factors, data_type, scanned)
+    if small is not None:  # a short gap-free record, certified: nothing compiled
+        sums, counts, scale, phase, drift, line = small
+    elif estimator in ("adev", "hdev") and data_type == "freq" and scanned[0] == 0 and _is_octave(factors):
         sums, counts, scale, phase, drift = octave_sums(estimator, data, factors, scanned)
         line = None
     else:
         hi, lo, scale, mode, bad, phase, drift, line = phase_parts(data, data_type, estimator, scanned)
         strides, first, last = term_ranges(estimator, n_phase, factors)
         sums, counts = level_sums(hi, lo, KERNEL_CODES[estimator], factors, strides, first, last, mode, bad)
-    m = factors.astype(np.float64)
-    denominator = _K[estimator] * m * m * (m * m if estimator in ("mdev", "tdev") else 1.0)
+    variance = variance_of_sums(estimator, sums, counts, factors, scale, data_type, rate)
+    return LevelsAndPhase(variance, counts, phase, drift, line)
+
+
+class NumpyLevels(NamedTuple):
+    """The sums of a short record's levels by :mod:`avar.stability.classic.small` (:func:`numpy_levels`)."""
+
+    sums: np.ndarray
+    counts: np.ndarray
+    scale: float
+    phase: np.ndarray
+    drift: float
+    line: float | None
+
+
+def numpy_levels(estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str,
+                 scanned: tuple) -> NumpyLevels | None:
+    """The sums of squared terms of every level in NumPy (:mod:`avar.stability.classic.small`:
+    nothing to compile) for gap-free data of at most :data:`NUMPY_SAMPLES` points whose levels hold
+    at most :data:`NUMPY_TERMS` terms in all while the kernels this call would run are not
+    compiled yet (or when
+    :mod:`avar._kernels.runtime.paths` forces NumPy); None otherwise, or where the NumPy path
+    cannot certify its error (the compiled kernels then run). ``scale``, ``phase``, ``drift``
+    and ``line`` as in :func:`phase_parts`."""
+    n_phase = data.shape[0] + (data_type == "freq")
+    strides, first, last = term_ranges(estimator, n_phase, factors)
+    counts = last - first
+
+    def kernels() -> tuple:  # the compiled route this call would take
+        if estimator in ("adev", "hdev") and data_type == "freq" and _is_octave(factors):
+            return (lag1_alpha_from_moments,)  # the pyramid's (its noise identification, compiled with it)
+        return PHASE_KERNELS + level_kernels(KERNEL_CODES[estimator], strides)
+
+    if scanned[0] != 0 or not numpy_path(lambda: int(np.maximum(counts, 0).sum()) + n_phase, NUMPY_TERMS, kernels,
+                                         fits=n_phase <= NUMPY_SAMPLES):
+        return None
+    is_phase = data_type == "phase"
+    _, _, _, centre, slope, scale = phase_line(data, data_type, estimator, scanned)
+    levels = small_level_sums(data, int(is_phase), centre, slope, scale, KERNEL_CODES[estimator], factors, strides,
+                              counts)
+    if levels is None:
+        return None
+    return NumpyLevels(levels.sums, levels.counts, scale, levels.phase, levels.slope * scale,
+                       levels.centre * scale if is_phase else None)
+
+
+def variance_of_sums(estimator: str, sums: np.ndarray, counts: np.ndarray, factors: np.ndarray, scale: float,
+                     data_type: str, rate: float) -> np.ndarray:
+    """The variances of the levels from their sums of squared terms and term counts (NaN where
+    no term is left): sum / (K m^2 counts) (modified: K m^4), in the units of the data once
+    ``scale`` (the phase's power of two) is undone; TDEV and HTDEV times tau^2 / 3 and
+    tau^2 / (10 / 3).
+
+    >>> variance_of_sums("oadev", np.array([8.0]), np.array([4]), np.array([1]), 1.0, "freq", 1.0).tolist()
+    [1.0]
+    """
+    m = np.asarray(factors).astype(np.float64)
+    denominator = _K[estimator] * m * m * (m * m if estimator in MODIFIED else 1.0)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         variance = sums / (denominator * counts) / scale / scale
         if data_type == "phase":
             variance = variance * rate * rate
-        if estimator == "tdev":
+        if estimator in TIME_FACTOR:
             tau = m / rate
-            variance = variance * tau * tau / 3.0
-    variance[counts == 0] = np.nan
-    return LevelsAndPhase(variance, counts, phase, drift, line)
+            variance = variance * tau * tau / TIME_FACTOR[estimator]
+    variance = np.where(np.asarray(counts) == 0, np.nan, variance)
+    return variance

@@ -1,4 +1,4 @@
-"""The time-and-frequency deviation family: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV, TOTDEV.
+"""The time-and-frequency deviation family: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV, TOTDEV, MHDEV, HTDEV.
 
 Named and defined as in NIST SP 1065 (Riley 2008), Stable32 and
 ``allantools``. Every function validates its input once, computes the
@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from avar.stability.classic.core import OctaveMoments, deviation_levels_and_phase
+from avar.stability.classic.core import HADAMARD, OctaveMoments, deviation_levels_and_phase
 from avar.stability.shared.deviation import Deviation
 from avar.stability.shared.docstrings import fill_parameters
 from avar.stability.shared.grids import deviation_factors
@@ -90,8 +90,8 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         raise TypeError(f"bias_correction must be True or False, got {bias_correction!r}")
     fixed = check_alpha(alpha)
     rate = check_options(estimator, data, rate, data_type, confidence, nan_policy)
-    drift_removed = estimator in ("hdev", "ohdev") and data_type == "freq"  # the scan finds the drift too
-    values, scanned = check_data(data, data_type, nan_policy, weigh=drift_removed)
+    drift_removed = estimator in HADAMARD and data_type == "freq"  # the scan finds the drift too
+    values, scanned = check_data(data, data_type, nan_policy, weigh=drift_removed, statistic=estimator)
     n_missing = int(scanned.n_missing)
     n_phase = values.size + (data_type == "freq")
     needed = MIN_PHASE_POINTS[estimator] - (data_type == "freq")
@@ -297,6 +297,64 @@ def totdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: 
     return _estimate("totdev", data, rate, data_type, taus, confidence, nan_policy, alpha, bias_correction)
 
 
+def mhdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
+          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
+    """Modified Hadamard deviation, NIST SP 1065 section 5.2.10::
+
+        Mod H sigma_y^2(tau) = sum_{j=0}^{N-4m} [sum_{i=j}^{j+m-1} (x_{i+3m} - 3 x_{i+2m} + 3 x_{i+m} - x_i)]^2
+                               / (6 m^2 tau^2 (N - 4m + 1)),
+
+    n = N - 4m + 1 terms, m = 1 .. N / 4. Dimensionless. Blind to a linear frequency
+    drift, like HDEV, and, like MDEV, it tells white from flicker PM (its variance falls as
+    tau^-3 and tau^-2). Each level costs O(N): the inner sums are fourth differences of the
+    running sum of x. Noise identification as OHDEV's (lag-1 with up to three differences,
+    B1 with this statistic's term count); EDF: Greenhall and Riley's algorithm for the
+    modified Hadamard variance (d = 3, overlapping, phase averaged over m), which their
+    paper covers (Stable32 does not compute this statistic).
+    {parameters}
+    References
+    ----------
+    S. Bregni and L. Jmoda, "Accurate estimation of the Hurst parameter of long-range
+    dependent traffic using modified Allan and Hadamard variances", IEEE Trans.
+    Communications 56, 2008. W. J. Riley, NIST SP 1065, 2008, section 5.2.10. C. A.
+    Greenhall and W. J. Riley, "Uncertainty of stability variances based on finite
+    differences", Proc. 35th PTTI, 2003.
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.mhdev([1.0, 3.0, 2.0, 5.0, 3.0, 4.0, 6.0, 2.0], taus="all")  # frequency: 9 phase points
+    >>> res.n.tolist(), res.deviation.round(6).tolist()
+    ([6, 2], [1.632993, 0.288675])
+    """
+    return _estimate("mhdev", data, rate, data_type, taus, confidence, nan_policy, alpha)
+
+
+def htdev(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
+          confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None) -> Deviation:
+    """Hadamard time deviation: sigma_xH(tau) = tau / sqrt(10/3) Mod H sigma_y(tau), in seconds.
+
+    What TDEV is to MDEV, HTDEV is to MHDEV (:func:`mhdev`: same terms, levels, noise and
+    EDF): the factor makes it the standard deviation of the phase for white PM, whose
+    Mod H sigma_y^2 is (10/3) sigma_x^2 / (m tau^2) (the weights 1, -3, 3, -1 of the four
+    m-point phase sums: 1 + 9 + 9 + 1 = 20 = 6 (10/3)). Not in NIST SP 1065 nor Stable32:
+    SigmaTau.jl (I. Lapinski) defines it, with this factor.
+    {parameters}
+    References
+    ----------
+    SigmaTau.jl, ``htdev`` (https://github.com/ianlap/SigmaTau.jl). W. J. Riley, NIST SP
+    1065, 2008, sections 5.2.6 (TDEV) and 5.2.10 (MHDEV).
+
+    Examples
+    --------
+    >>> import avar
+    >>> res = avar.htdev([1.0, 3.0, 2.0, 5.0, 3.0, 4.0, 6.0, 2.0], rate=2.0)
+    >>> res.taus.tolist(), res.deviation.round(6).tolist()  # 0.5 s / sqrt(10/3) * 1.632993, ...
+    ([0.5, 1.0], [0.447214, 0.158114])
+    """
+    return _estimate("htdev", data, rate, data_type, taus, confidence, nan_policy, alpha)
+
+
 _TOTDEV_BIAS = """    bias_correction : bool
         TOTVAR is biased low against the Allan variance for flicker and
         random-walk FM: E[TOTVAR] / AVAR = 1 - a tau / T, T = N tau0 (N the
@@ -305,6 +363,6 @@ _TOTDEV_BIAS = """    bias_correction : bool
         divides by it at the levels whose alpha (identified or fixed) is
         -1 or -2; ``False`` gives the raw statistic, as ``allantools``.
 """
-for _function in (adev, oadev, mdev, tdev, hdev, ohdev, totdev):
+for _function in (adev, oadev, mdev, tdev, hdev, ohdev, totdev, mhdev, htdev):
     fill_parameters(_function, ALPHA_PARAMETER + (_TOTDEV_BIAS if _function is totdev else ""))
 del _function

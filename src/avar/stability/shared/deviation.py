@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from avar._escape import html_text
 from avar._frozen import frozen_array
 from avar._validation import check_freq, short_repr
 from avar.stability.shared.confidence import format_confidence
@@ -26,9 +27,9 @@ class Deviation:
 
     Build it with :func:`avar.adev`, :func:`avar.oadev`, :func:`avar.mdev`,
     :func:`avar.tdev`, :func:`avar.hdev`, :func:`avar.ohdev`,
-    :func:`avar.totdev`, the total and Theo statistics :func:`avar.mtotdev`,
-    :func:`avar.ttotdev`, :func:`avar.htotdev`, :func:`avar.theo1` and
-    :func:`avar.theoh`, or :func:`avar.pdev`, :func:`avar.mtie`,
+    :func:`avar.totdev`, :func:`avar.mhdev`, :func:`avar.htdev`, the total and Theo
+    statistics :func:`avar.mtotdev`, :func:`avar.ttotdev`, :func:`avar.htotdev`,
+    :func:`avar.mhtotdev`, :func:`avar.theo1` and :func:`avar.theoh`, or :func:`avar.pdev`, :func:`avar.mtie`,
     :func:`avar.tierms`, :func:`avar.gcodev`, :func:`avar.three_cornered_hat`
     or :class:`avar.Stream`; the fields are read-only. MTIE, TIE rms and
     GCODEV carry no bounds (``edf``, ``lci``, ``uci`` NaN).
@@ -40,7 +41,7 @@ class Deviation:
     averaging_factors : ndarray of int64
         Averaging factors m.
     deviation : ndarray
-        The deviation (dimensionless; TDEV in seconds).
+        The deviation (dimensionless; TDEV, HTDEV and TTOTDEV in seconds).
     variance : ndarray
         Its square.
     n_terms : ndarray of int64
@@ -156,7 +157,7 @@ class Deviation:
         return f"<Deviation {self.describe()}>"
 
     def _repr_html_(self) -> str:
-        return f"<p>{self.describe()}</p>" + self.summary().to_html(index=False)
+        return f"<p>{html_text(self.describe())}</p>" + self.summary().to_html(index=False)
 
     def plot(self, **kwargs: Any):
         """Log-log plot of the deviation with its error bars; see :func:`avar.plotting.plot_deviation`."""

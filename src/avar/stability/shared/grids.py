@@ -128,17 +128,21 @@ def largest_factor(statistic: str, n_phase: int) -> int:
 
     N is the number of phase points. Classic statistics: the table of
     :mod:`avar.stability.shared.term_counts`; MTOTDEV, TTOTDEV: floor(N / 3); HTOTDEV:
-    floor((N - 1) / 3); Theo1 and ThêoH: the largest even m <= N - 1; MTIE, TIE rms: N - 1;
-    PDEV: floor((N - 1) / 2).
+    floor((N - 1) / 3); MHTOTDEV: floor(N / 4); Theo1 and ThêoH: the largest even m <= N - 1;
+    MTIE, TIE rms: N - 1; PDEV: floor((N - 1) / 2).
 
     >>> [largest_factor(e, 1001) for e in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")]
     [500, 500, 333, 333, 333, 333, 1000]
+    >>> [largest_factor(e, 1001) for e in ("mhdev", "htdev", "mhtotdev")]
+    [250, 250, 250]
     >>> [largest_factor(e, 1001) for e in ("mtotdev", "htotdev", "theo1", "mtie", "pdev")]
     [333, 333, 1000, 1000, 500]
     """
     n = int(n_phase)
     if statistic in ("adev", "oadev", "pdev"):
         return max(0, (n - 1) // 2)
+    if statistic in ("mhdev", "htdev", "mhtotdev"):
+        return max(0, n // 4)
     if statistic in ("mdev", "tdev", "mtotdev", "ttotdev"):
         return max(0, n // 3)
     if statistic in ("hdev", "ohdev", "htotdev"):
@@ -153,7 +157,8 @@ def max_factor(estimator: str, n_phase: int) -> int:
     return largest_factor(estimator, n_phase)
 
 
-def deviation_factors(estimator: str, n_phase: int, rate: float = 1.0, taus: Any = "octave") -> np.ndarray:
+def deviation_factors(estimator: str, n_phase: int, rate: float = 1.0, taus: Any = "octave", *,
+                      statistic: str | None = None) -> np.ndarray:
     """Averaging factors m of a tau grid for ``n_phase`` phase points.
 
     Parameters
@@ -186,12 +191,13 @@ def deviation_factors(estimator: str, n_phase: int, rate: float = 1.0, taus: Any
     """
     largest = largest_factor(estimator, n_phase)
     return grid_factors(taus, rate, largest, first_octave=0,
-                        context=f"of {estimator} (averaging factors 1..{largest} at rate = {rate:g} Hz "
+                        context=f"of {statistic or estimator} (averaging factors 1..{largest} at rate = {rate:g} Hz "
                                 f"with {n_phase} phase points)")
 
 
-def total_factors(estimator: str, n_phase: int, rate: float, taus: Any) -> np.ndarray:
-    """Averaging factors of a tau grid (see :func:`avar.stability.shared.grids.grid_factors`).
+def total_factors(estimator: str, n_phase: int, rate: float, taus: Any, *, statistic: str | None = None) -> np.ndarray:
+    """Averaging factors of a tau grid (see :func:`avar.stability.shared.grids.grid_factors`); errors name
+    ``statistic`` (default ``estimator``: ThêoH's Theo1 levels say theoh).
 
     Theo1 (and ThêoH's Theo1 levels) take even m only, tau = 0.75 m tau0:
     ``"octave"`` m = 2, 4, 8, ...; ``"decade"`` the even ones of 1, 2, 4 x
@@ -202,7 +208,7 @@ def total_factors(estimator: str, n_phase: int, rate: float, taus: Any) -> np.nd
     ([2, 4, 8, 16, 32, 64], [2, 4])
     """
     largest = largest_factor(estimator, n_phase)
-    context = f"of {estimator} with {n_phase} phase points at rate = {rate:g} Hz"
+    context = f"of {statistic or estimator} with {n_phase} phase points at rate = {rate:g} Hz"
     if estimator != "theo1":
         return grid_factors(taus, rate, largest, first_octave=0, context=f"{context} (m = 1..{largest})")
     if largest < 2:
@@ -227,6 +233,6 @@ def total_factors(estimator: str, n_phase: int, rate: float, taus: Any) -> np.nd
     requested = np.atleast_1d(scaled) * rate
     odd = (np.abs(requested - np.round(requested)) > 1e-9 * requested) | (np.round(requested) % 2 == 1)
     if odd.any():
-        raise ValueError(f"theo1 taus must be 0.75 m / rate with m even, got {short_repr((requested[odd] * 0.75 / rate).tolist())} "
+        raise ValueError(f"{statistic or estimator} taus must be 0.75 m / rate with m even, got {short_repr((requested[odd] * 0.75 / rate).tolist())} "
                          f"s (m = {short_repr(requested[odd].tolist())})")
     return exact

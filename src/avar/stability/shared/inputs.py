@@ -49,9 +49,10 @@ class ScaledData(NamedTuple):
 NAN_POLICIES = ("raise", "omit")
 
 
-def check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False) -> CheckedData:
+def check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False,
+               statistic: str = "the statistic") -> CheckedData:
     """Float64 values of ``data`` and their :func:`scan` (NaN count, sum, min, max, and with
-    ``weigh`` the centred moment), or an error naming ``data``."""
+    ``weigh`` the centred moment), or an error naming ``data`` (and ``statistic``)."""
     if isinstance(data, pd.DataFrame):
         raise TypeError("data is a DataFrame; give one column (a 1-D series) of phase or frequency data")
     if isinstance(data, pd.Series):
@@ -75,8 +76,10 @@ def check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False) 
         missing = np.flatnonzero(np.isnan(values))
         raise ValueError(f"data has {n_missing} NaN value(s), the first at index {missing[0]}; pass "
                          "nan_policy='omit' to skip the terms that touch them, or remove/fill them")
+    if values.size == 0:
+        raise ValueError(f"data holds no samples (an empty series); {statistic} needs {data_type} data")
     if n_missing == values.size:
-        raise ValueError("data holds only NaN values")
+        raise ValueError(f"data holds only NaN values ({values.size}); {statistic} needs {data_type} data")
     return CheckedData(values, scanned)
 
 

@@ -2,7 +2,7 @@
 
 Every statistic of the family is one :class:`Statistic` in :data:`STATISTICS`: its
 name (the public function ``avar.NAME`` and ``avar deviation --stat NAME``), long name,
-family folder, whether it carries chi-squared bounds, and for the classic seven the
+family folder, whether it carries chi-squared bounds, and for the classic statistics the
 kernel code and the fewest phase points with one term. The tables the rest of the
 package reads (:data:`DEVIATION_STATISTICS`, :data:`CLASSIC`, :data:`TOTAL`,
 :data:`LONG_NAMES`, ...) are views of it, so a new statistic is one record here.
@@ -54,11 +54,14 @@ _RECORDS = (
     Statistic("hdev", "Hadamard deviation", "classic", kernel_code=1, min_phase_points=4),
     Statistic("ohdev", "overlapping Hadamard deviation", "classic", kernel_code=1, min_phase_points=4),
     Statistic("totdev", "total deviation", "classic", kernel_code=3, min_phase_points=3),
+    Statistic("mhdev", "modified Hadamard deviation", "classic", kernel_code=4, min_phase_points=4),
+    Statistic("htdev", "Hadamard time deviation", "classic", kernel_code=4, min_phase_points=4),
     Statistic("mtotdev", "modified total deviation", "total"),
     Statistic("ttotdev", "time total deviation", "total"),
     Statistic("htotdev", "Hadamard total deviation", "total"),
     Statistic("theo1", "Theo1 deviation", "total"),
     Statistic("theoh", "ThêoH deviation (OADEV and bias-removed Theo1)", "total"),
+    Statistic("mhtotdev", "modified Hadamard total deviation", "total"),
     Statistic("pdev", "parabolic deviation", "time_error"),
     Statistic("mtie", "maximum time interval error", "time_error", bounded=False),
     Statistic("tierms", "time interval error rms", "time_error", bounded=False),
@@ -72,7 +75,7 @@ STATISTICS = MappingProxyType({record.name: record for record in _RECORDS})
 DEVIATION_STATISTICS = tuple(name for name, s in STATISTICS.items() if s.family != "pair")
 #: Statistics of two series that also give a :class:`avar.Deviation` (not on the command line).
 PAIR_STATISTICS = tuple(name for name, s in STATISTICS.items() if s.family == "pair")
-#: The classic seven of NIST SP 1065, with their own variance core.
+#: The classic seven of NIST SP 1065 and the modified Hadamard pair (MHDEV, HTDEV), with their own variance core.
 CLASSIC = tuple(name for name, s in STATISTICS.items() if s.family == "classic")
 #: The total and Theo statistics.
 TOTAL = tuple(name for name, s in STATISTICS.items() if s.family == "total")

@@ -14,6 +14,8 @@ tdev      N - 3m + 1                   floor(N / 3)           2
 hdev      floor((N - 1) / m) - 2       floor((N - 1) / 3)     1, stride m
 ohdev     N - 3m                       floor((N - 1) / 3)     1, stride 1
 totdev    N - 2                        N - 1                  3
+mhdev     N - 4m + 1                   floor(N / 4)           4
+htdev     N - 4m + 1                   floor(N / 4)           4
 ========  ===========================  =====================  ==========
 
 Every level with at least one term exists (Stable32 and NIST compute a
@@ -44,8 +46,8 @@ def n_differences(n: int, factors: np.ndarray, type: str) -> np.ndarray:
 def term_counts(estimator: str, n_phase: int, factors: Any) -> np.ndarray:
     """Number of terms n(m) of every level (no gaps) of a classic, total or Theo statistic.
 
-    Classic: the table above; MTOTDEV, TTOTDEV: N - 3m + 1; HTOTDEV: N - 3m; Theo1:
-    (N - m) floor(m / 2).
+    Classic: the table above; MTOTDEV, TTOTDEV: N - 3m + 1; HTOTDEV: N - 3m; MHTOTDEV:
+    N - 4m + 1; Theo1: (N - m) floor(m / 2).
 
     >>> term_counts("adev", 1001, np.array([1, 10, 100])).tolist()
     [999, 99, 9]
@@ -64,6 +66,8 @@ def term_counts(estimator: str, n_phase: int, factors: Any) -> np.ndarray:
         "hdev": (n - 1) // m - 2,
         "ohdev": n - 3 * m,
         "totdev": np.full_like(m, n - 2),
+        "mhdev": n - 4 * m + 1,
+        "htdev": n - 4 * m + 1,
     }
     return counts[estimator]
 
@@ -80,6 +84,8 @@ def _total_term_counts(estimator: str, n_phase: int, factors: Any) -> np.ndarray
         return n - 3 * m + 1
     if estimator == "htotdev":
         return n - 3 * m
+    if estimator == "mhtotdev":
+        return n - 4 * m + 1
     return (n - m) * (m // 2)
 
 

@@ -120,7 +120,7 @@ def three_cornered_hat(ab: Any, bc: Any, ca: Any, rate: float | None = None, dat
 def _named_check(data: Any, name: str, data_type: str, nan_policy: str) -> np.ndarray:
     """:func:`avar.stability.shared.inputs.check_data` with the argument's own name in its messages."""
     try:
-        return check_data(data, data_type, nan_policy)[0]
+        return check_data(data, data_type, nan_policy, statistic="gcodev")[0]
     except (TypeError, ValueError) as error:
         raise type(error)(str(error).replace("data", name, 1)) from None
 

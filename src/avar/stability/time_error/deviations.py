@@ -58,7 +58,7 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
               nan_policy: Any, alpha: Any) -> Deviation:
     rate = check_options(statistic, data, rate, data_type, confidence, nan_policy)
     fixed = check_alpha(alpha)
-    values, scanned = check_data(data, data_type, nan_policy)
+    values, scanned = check_data(data, data_type, nan_policy, statistic=statistic)
     if statistic != "mtie":  # a range needs no square
         check_not_tiny(statistic, scanned)
     n_phase = values.size + (data_type == "freq")
@@ -84,6 +84,8 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         else:
             sums, n = tierms_levels(phase, factors, gaps, extra)
             m, scale = factors.astype(np.float64), 1.0
+            if data_type == "freq":  # m = N: the one term spans the mean-removed data, zero by construction
+                sums = np.where((factors == n_phase - 1) & (n > 0), 0.0, sums)
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # overflow: an error below
             variance = sums / (scale * n)
         if statistic == "pdev":

@@ -38,7 +38,7 @@ _KIND = {"mtotdev": 0, "ttotdev": 0, "htotdev": 1, "theo1": 2}
 #: their term counts from 6 averages), as Stable32 (its tables of two records: the MDEV and OHDEV rules
 #: miss its alpha where few terms remain); Theo1 OADEV's at 0.75 m.
 _NOISE_RULES = {"mtotdev": "mtotdev", "ttotdev": "ttotdev", "htotdev": "htotdev", "theo1": "oadev"}
-_MIN_PHASE = {"mtotdev": 3, "ttotdev": 3, "htotdev": 4, "theo1": 3}
+_MIN_PHASE = {"mtotdev": 3, "ttotdev": 3, "htotdev": 4, "theo1": 3, "mhtotdev": 4}
 
 _PARAMETERS = """
     Parameters
@@ -80,7 +80,7 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
     (scaled by ``scale``, a power of two; HTOTDEV: its linear frequency drift removed too, as
     every statistic here is blind to it) with gaps filled, ``bad`` their prefix count."""
     rate = check_options(estimator, data, rate, data_type, confidence, nan_policy)
-    values, scanned = check_data(data, data_type, nan_policy)
+    values, scanned = check_data(data, data_type, nan_policy, statistic=estimator)
     check_not_tiny(estimator, scanned)
     needed = _MIN_PHASE.get(estimator, 3) - (data_type == "freq")
     if values.size < needed:

@@ -38,8 +38,8 @@ def _levels(n_phase: int, rate: float, taus: Any, k: float | None) -> tuple[np.n
     Stable32's table: OADEV at its factors up to N / 4, Theo1 at its even m from floor(N / 5) (the
     two overlap between N / 5 and N / 4)."""
     if isinstance(taus, str):
-        allan = deviation_factors("oadev", n_phase, rate, taus)
-        theo = total_factors("theo1", n_phase, rate, taus)
+        allan = deviation_factors("oadev", n_phase, rate, taus, statistic="theoh")
+        theo = total_factors("theo1", n_phase, rate, taus, statistic="theoh")
         if k is None:
             return allan[allan <= n_phase // 4], theo[theo >= n_phase // THEO_FROM]
         return allan[allan < k], theo[0.75 * theo >= k]
@@ -55,8 +55,10 @@ def _levels(n_phase: int, rate: float, taus: Any, k: float | None) -> tuple[np.n
         short = (np.abs(m - np.round(m)) <= 1e-9 * np.maximum(m, 1.0)) & (np.round(m) <= n_phase // 4)
     else:
         short = m < k
-    allan = deviation_factors("oadev", n_phase, rate, requested[short]) if short.any() else np.zeros(0, np.int64)
-    theo = total_factors("theo1", n_phase, rate, requested[~short]) if (~short).any() else np.zeros(0, np.int64)
+    allan = (deviation_factors("oadev", n_phase, rate, requested[short], statistic="theoh") if short.any()
+             else np.zeros(0, np.int64))
+    theo = (total_factors("theo1", n_phase, rate, requested[~short], statistic="theoh") if (~short).any()
+            else np.zeros(0, np.int64))
     return allan, theo
 
 

@@ -27,7 +27,8 @@ __all__ = ["DEFAULT_CONFIDENCE", "EDF_ESTIMATORS", "ESTIMATORS", "J_MAX", "STABL
 J_MAX = 100
 #: Estimator name -> (d, overlapping, modified) of Greenhall's algorithm.
 ESTIMATORS = {"adev": (2, False, False), "oadev": (2, True, False), "mdev": (2, True, True),
-              "tdev": (2, True, True), "hdev": (3, False, False), "ohdev": (3, True, False)}
+              "tdev": (2, True, True), "hdev": (3, False, False), "ohdev": (3, True, False),
+              "mhdev": (3, True, True), "htdev": (3, True, True)}
 EDF_ESTIMATORS = (*ESTIMATORS, "totdev")
 
 # Greenhall and Riley (2003), Tables 1 and 2: (a0, a1) by alpha (2 .. -4) and d (1 .. 3);
@@ -300,13 +301,15 @@ def estimator_edf(estimator: str, alpha: np.ndarray, factors: np.ndarray, n_phas
 
     ``"adev"`` (d = 2, non-overlapping), ``"oadev"`` (d = 2, overlapping),
     ``"mdev"`` and ``"tdev"`` (d = 2, modified, overlapping), ``"hdev"``
-    (d = 3, non-overlapping) and ``"ohdev"`` (d = 3, overlapping) by
-    :func:`greenhall_edf`; ``"totdev"`` by :func:`totdev_edf`.
+    (d = 3, non-overlapping), ``"ohdev"`` (d = 3, overlapping), ``"mhdev"`` and ``"htdev"``
+    (d = 3, modified, overlapping: Greenhall and Riley's algorithm covers the modified
+    Hadamard variance too) by :func:`greenhall_edf`; ``"totdev"`` by :func:`totdev_edf`.
 
     Parameters
     ----------
     estimator : str
-        One of ``"adev"``, ``"oadev"``, ``"mdev"``, ``"tdev"``, ``"hdev"``, ``"ohdev"``, ``"totdev"``.
+        One of ``"adev"``, ``"oadev"``, ``"mdev"``, ``"tdev"``, ``"hdev"``, ``"ohdev"``, ``"mhdev"``,
+        ``"htdev"``, ``"totdev"``.
     alpha : array_like of int
         Power-law exponent per level, -2 .. 2 (see :func:`avar.stability.uncertainty.noise_id.identify_noise`).
     factors : array_like of int

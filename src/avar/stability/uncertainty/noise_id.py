@@ -19,6 +19,7 @@ import numpy as np
 from avar._validation import short_repr
 from avar.stability.shared.term_counts import term_counts
 from avar.stability.shared.term_counts import term_counts as total_term_counts
+from avar.stability.uncertainty.lag1 import lag1_alphas, running_sums
 
 #: The lag-1 autocorrelation is used where at least this many frequency averages K = (N - 1) // m remain
 #: (Stable32 switches to B1 at K = 29: its MDEV table of an OCXO's 19,982 readings, m = 659 -> 672).
@@ -50,6 +51,7 @@ class NoiseRule(int):
 #: Estimator -> its :class:`NoiseRule` (the lag-1 method's dmax, and the estimator).
 NOISE_ID_ESTIMATORS = {name: NoiseRule(dmax, name) for name, dmax in
                        {"adev": 2, "oadev": 2, "mdev": 2, "tdev": 2, "totdev": 2, "hdev": 3, "ohdev": 3,
+                        "mhdev": 3, "htdev": 3,
                         **dict.fromkeys(TOTALS, 2)}.items()}
 
 
@@ -129,8 +131,9 @@ def identify_noise(phase: Any, factors: Any, estimator: str, *, from_frequency: 
         as x = (0, cumsum(y)) tau0.
     factors : array_like of int
         Averaging factors m, 1 <= m < N.
-    estimator : {"adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev"}
-        The deviation whose levels these are (it sets dmax, B1's sample
+    estimator : str
+        One of "adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "mhdev", "htdev", "totdev",
+        "mtotdev", "ttotdev", "htotdev": the deviation whose levels these are (it sets dmax, B1's sample
         size and where B1 stops).
     from_frequency : bool, optional
         The phase was integrated from frequency data: the lag-1 method removes
@@ -262,17 +265,12 @@ def octave_noise(stats: np.ndarray, tails: np.ndarray, m: np.ndarray, dmax: int,
 def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line_free: bool,
                      line: float | None) -> np.ndarray:
     """:func:`phase_noise` before the levels without an estimate are filled (NaN there)."""
-    from avar._kernels.uncertainty.noise_id import lag1_levels, lag1_levels_split
-
     n = x.size
     acf = (n - 1) // m >= MIN_ACF_POINTS
     alpha = np.full(m.size, np.nan)
     if acf.any():
-        found = np.empty(int(acf.sum()))
         seen = x + drift * _triangular(np.arange(n, dtype=np.float64)) if drift else x  # the drift is data
-        (lag1_levels_split if found.size > 1 else lag1_levels)(seen, m[acf], int(dmax),
-                                                               np.nan if line is None else float(line), found)
-        alpha[acf] = found
+        alpha[acf] = lag1_alphas(seen, m[acf], int(dmax), np.nan if line is None else float(line))
     if not acf.all():
         lazy: dict[int, np.ndarray] = {}
 
@@ -281,11 +279,8 @@ def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line
 
         def running(step: int) -> np.ndarray:  # R(n)'s running sum at every step-th index, built when needed
             if step not in lazy:
-                if line_free:  # no large line to condition away: one compiled pass, block sums
-                    from avar._kernels.uncertainty.noise_id import running_sum
-
-                    lazy[step] = np.empty(n // step + 1)
-                    running_sum(x, drift, step, lazy[step])
+                if line_free:  # no large line to condition away: one pass, block sums
+                    lazy[step] = running_sums(x, drift, step)
                 else:
                     line_free_phase = _remove_line(points(np.arange(n)))
                     lazy[step] = np.concatenate(([0.0], np.cumsum(line_free_phase)))[::step]

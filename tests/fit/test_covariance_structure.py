@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 from scipy.linalg import toeplitz
 
-from avar.fit.gmwm.covariance import mo_av_covariance
-from avar.fit.report.level_covariance import MAX_EXACT_LEVELS, _phi, _second_sums, level_covariance, structure_function
-from avar.fit.report.sensor_terms import Component, basis
+from avar.fit.covariance.exact import exact_covariance
+from avar.fit.covariance.structure import MAX_EXACT_LEVELS, _phi, _second_sums, structure_covariance, structure_function
+from avar.fit.terms import Component, basis
 from avar.models import AR1, RW, WN
 
 
@@ -86,7 +86,7 @@ def test_the_structure_function_gives_each_terms_allan_variance(kind, shape):
 def test_level_covariance_equals_the_dense_quadratic_forms(components, omega):
     n, factors = 300, np.array([1, 2, 4, 8, 16, 32, 64, 100, 149])  # the last level has M = 2 terms
     exact = brute_force(components, n, factors, omega)
-    fast = level_covariance(components, n, factors)
+    fast = structure_covariance(components, n, factors)
     spread = np.sqrt(np.diag(exact))
     # the trapezoid between the summand's kinks errs by < 1e-3 of the levels' spread
     np.testing.assert_allclose(fast / np.outer(spread, spread), exact / np.outer(spread, spread), atol=1e-3)
@@ -98,18 +98,18 @@ def test_long_series_match_the_fft_covariance_and_cost_little():
     n, factors = 2**14, 2 ** np.arange(13)
     for model, components in [(WN(sigma2=1.0) + RW(gamma2=1e-3), [Component("WN", 1.0), Component("RW", 1e-3)]),
                               (AR1(phi=0.99, sigma2=0.5), [Component("AR1", 0.5, 0.99)])]:
-        exact = mo_av_covariance(model, n, factors)
+        exact = exact_covariance(model, n, factors)
         spread = np.sqrt(np.diag(exact))
-        fast = level_covariance(components, n, factors)
+        fast = structure_covariance(components, n, factors)
         np.testing.assert_allclose(fast / np.outer(spread, spread), exact / np.outer(spread, spread), atol=1e-3)
 
 
 def test_terms_that_mix_are_not_one_power_law():
     """Where white noise and a random walk cross, the levels' correlation lies between the pure laws'."""
     n, factors = 2**16, 2 ** np.arange(14)
-    cross = level_covariance([Component("WN", 1.0), Component("RW", 1e-5)], n, factors)
-    white = level_covariance([Component("WN", 1.0)], n, factors)
-    walk = level_covariance([Component("RW", 1e-5)], n, factors)
+    cross = structure_covariance([Component("WN", 1.0), Component("RW", 1e-5)], n, factors)
+    white = structure_covariance([Component("WN", 1.0)], n, factors)
+    walk = structure_covariance([Component("RW", 1e-5)], n, factors)
 
     def adjacent(c):
         spread = np.sqrt(np.diag(c))
@@ -124,8 +124,8 @@ def test_a_sinusoid_adds_to_the_levels_not_to_their_covariance():
     """Fixed amplitude, random phase: its share of each estimate is all but constant between records."""
     n, factors = 300, 2 ** np.arange(7)
     noise = [Component("WN", 1.0), Component("AR1", 0.2, 0.9)]
-    np.testing.assert_array_equal(level_covariance(noise + [Component("SIN", 0.3, 0.07)], n, factors),
-                                  level_covariance(noise, n, factors))
+    np.testing.assert_array_equal(structure_covariance(noise + [Component("SIN", 0.3, 0.07)], n, factors),
+                                  structure_covariance(noise, n, factors))
 
 
 def test_a_dense_grid_is_interpolated_from_log_spaced_levels():
@@ -133,9 +133,9 @@ def test_a_dense_grid_is_interpolated_from_log_spaced_levels():
     components = [Component("WN", 1.0), Component("FN", 0.01), Component("RW", 1e-5)]
     dense = np.unique(np.geomspace(1, 5000, 90).round().astype(np.int64))
     assert dense.size > MAX_EXACT_LEVELS
-    interpolated = level_covariance(components, n, dense)
+    interpolated = structure_covariance(components, n, dense)
     subset = dense[::3]
-    exact = level_covariance(components, n, subset)
+    exact = structure_covariance(components, n, subset)
     spread = np.sqrt(np.diag(exact))
     np.testing.assert_allclose(interpolated[::3, ::3] / np.outer(spread, spread), exact / np.outer(spread, spread),
                                atol=0.03)

@@ -1,12 +1,12 @@
-"""Tests of avar.fit.gmwm.covariance and weights='efficient' of avar.gmwm."""
+"""Tests of avar.fit.covariance.exact and weights='efficient' of avar.gmwm."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from avar.fit.covariance.exact import exact_covariance, increment_autocovariance
 from avar.fit.gmwm import gmwm, octave_factors
-from avar.fit.gmwm.covariance import increment_autocovariance, mo_av_covariance
 from avar.models import AR1, DR, FN, QN, RW, WN
 from avar.stability.allan.results import AllanVariance
 
@@ -51,7 +51,7 @@ def reference_covariance(model, n, factors):
 @pytest.mark.parametrize("model", MODELS, ids=repr)
 def test_covariance_matches_the_quadratic_form_loops(model):
     factors = np.array([1, 2, 3, 5, 8, 11])
-    np.testing.assert_allclose(mo_av_covariance(model, 23, factors), reference_covariance(model, 23, factors),
+    np.testing.assert_allclose(exact_covariance(model, 23, factors), reference_covariance(model, 23, factors),
                                rtol=1e-10, atol=1e-13 * np.abs(reference_covariance(model, 23, factors)).max())
 
 
@@ -61,7 +61,7 @@ def test_covariance_matches_simulation():
     draws = np.array([[np.mean((np.convolve(x, np.ones(m) / m, "valid")[m:] -
                                 np.convolve(x, np.ones(m) / m, "valid")[:-m]) ** 2) / 2 for m in factors]
                       for x in model.simulate_replicates(400, 4000, seed=3)])
-    exact = mo_av_covariance(model, 400, factors)
+    exact = exact_covariance(model, 400, factors)
     sample = np.cov(draws, rowvar=False)
     scale = np.sqrt(np.outer(np.diag(exact), np.diag(exact)))
     # 4000 replicates: variances within ~2.3% (1 SD), correlations within ~0.016

@@ -1,19 +1,10 @@
-"""Covariance of the maximal-overlap Allan variance estimates of a fitted noise model: :func:`level_covariance`.
+"""The covariance of the maximal-overlap AV estimates from the model's structure function: any N, flicker included.
 
-The sandwich intervals of :mod:`avar.fit.report.sensor_fit` need the
-covariance of the estimates nu_hat(m_j) across levels. Tables of pure power
-laws (one noise type per level) misstate it where terms mix, which is where a
-sensor's random walk and bias instability are read. This module computes it
-for the fitted sum of processes itself, as the exact Gaussian covariance
-(the formula of :func:`avar.fit.gmwm.covariance.mo_av_covariance`)::
-
-    Cov(nu_hat_j, nu_hat_k) = 1 / (M_j M_k) sum_h c_jk(h) [2 gamma_jk(h)^2 + 4 mu_j mu_k gamma_jk(h)],
-
-with M_j = N - 2 m_j + 1 terms, c_jk(h) the number of pairs at lag h, mu the
-means a ramp gives, and gamma_jk the cross-covariance of the Allan-filtered
-series W_s(m) = (ybar_{s+m} - ybar_s) / sqrt(2). Every term has stationary
-increments, so gamma_jk follows from the structure function
-D(k) = Var(y_{t+k} - y_t) of the whole model (the sum of its terms')::
+The formula of :mod:`avar.fit.covariance.formula` needs gamma_jk, the
+cross-covariance of the Allan-filtered series W_s(m) = (ybar_{s+m} - ybar_s) / sqrt(2).
+Every term but the sinusoid has stationary increments, so gamma_jk follows from
+the structure function D(k) = Var(y_{t+k} - y_t) of the whole model (the sum of
+its terms')::
 
     Cov(y_a - y_b, y_c - y_d) = [D(a - d) + D(b - c) - D(a - c) - D(b - d)] / 2,
     sum_{i<L1} sum_{l<L2} D(c + i - l) = S2(c + L1 + 1) - S2(c + L1 - L2 + 1) - S2(c + 1) + S2(c - L2 + 1),
@@ -25,7 +16,13 @@ computed once for every channel. S2 of QN, WN, FN and RW is in closed form
 (no table of the log's length); a Gauss-Markov term's is summed outward from 0. The sum over h runs exactly near
 the kinks of gamma_jk and c_jk and by the trapezoid rule on integer nodes in
 between (the summand is smooth there), a few thousand evaluations per pair of
-levels whatever N.
+levels whatever N, to :data:`ACCURACY` of the levels' spread (the plain twin,
+:mod:`avar.fit.covariance.exact`, sums every lag).
+
+Tables of pure power laws (one noise type per level) misstate this covariance
+where terms mix, which is where a sensor's random walk and bias instability are
+read: the noise report's sandwich intervals (:mod:`avar.fit.report.uncertainty`)
+take it for the fitted sum of processes itself.
 
 Per-sample structure functions: QN 6 q2 at lag 1, 4 q2 beyond; WN 2 sigma2;
 FN (4 b2 / pi) sum_{j<=k} 1 / (2 j - 1); RW gamma2 |k|; AR1 2 (c(0) - c(k)),
@@ -51,12 +48,18 @@ import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from avar.fit.report.sensor_terms import Component
+from avar.fit.covariance.formula import level_counts, pair_counts, summand
+from avar.fit.terms import Component, components_of
 
-__all__ = ["level_covariance", "structure_function", "MAX_EXACT_LEVELS"]
+__all__ = ["structure_covariance", "structure_function", "MAX_EXACT_LEVELS", "ACCURACY"]
+
+#: Error of the covariance relative to the levels' spread sigma_j sigma_k (the trapezoid rule between
+#: the summand's kinks), within :data:`MAX_EXACT_LEVELS` levels.
+ACCURACY = 1e-3
 
 #: Integers summed exactly on each side of a kink of the summand.
 DENSE = 24
@@ -68,14 +71,14 @@ MAX_EXACT_LEVELS = 40
 TAIL = 4
 
 
-def structure_function(components: Sequence[Component], size: int) -> np.ndarray:
-    """D(k), k = 0..size, of the Gaussian terms of ``components`` (per-sample parameters; no DR, no SIN).
+def structure_function(model: Any, size: int) -> np.ndarray:
+    """D(k), k = 0..size, of the Gaussian terms of ``model`` (per-sample parameters; DR and SIN add nothing).
 
     >>> structure_function([Component("WN", 1.0), Component("RW", 0.5)], 3).tolist()
     [0.0, 2.5, 3.0, 3.5]
     """
     out = np.zeros(size + 1)
-    for c in components:
+    for c in components_of(model):
         if c.kind in UNIT_KINDS:
             out += c.scale * _unit_structure(c.kind, size)
         elif c.kind == "AR1":
@@ -136,13 +139,13 @@ def _nodes(low: int, high: int, kinks: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return nodes, weights
 
 
-def level_covariance(components: Sequence[Component], n: int, factors: np.ndarray) -> np.ndarray:
+def structure_covariance(model: Any, n: int, factors: np.ndarray) -> np.ndarray:
     """Gaussian covariance of the maximal-overlap AV estimates of a sum of terms at averaging ``factors``.
 
     Parameters
     ----------
-    components : sequence of Component
-        The model's terms, per-sample parameters (:mod:`avar.fit.report.sensor_terms`).
+    model : NoiseModel or sequence of processes or components
+        The model's terms, per-sample parameters (:func:`avar.fit.terms.components_of`).
     n : int
         Series length N (samples).
     factors : ndarray of int
@@ -159,10 +162,11 @@ def level_covariance(components: Sequence[Component], n: int, factors: np.ndarra
     --------
     White noise of unit variance: the lag-1 Allan variance of N samples has variance about 3 / N.
 
-    >>> cov = level_covariance([Component("WN", 1.0)], 10_000, np.array([1, 2]))
+    >>> cov = structure_covariance([Component("WN", 1.0)], 10_000, np.array([1, 2]))
     >>> round(float(cov[0, 0]) * 10_000, 2)
     3.0
     """
+    components = components_of(model)
     factors = np.asarray(factors, dtype=np.int64)
     if factors.size > MAX_EXACT_LEVELS:
         return _interpolated(components, n, factors)
@@ -180,7 +184,7 @@ def level_covariance(components: Sequence[Component], n: int, factors: np.ndarra
         gamma += _gamma(_second_sums(structure_function(shaped, plan.size)), plan)
     ramp = sum(c.scale for c in components if c.kind == "DR")
     mean2 = (ramp / 2.0) * plan.mj * plan.mk  # mu_j mu_k at every node, mu_m = sqrt(omega2 / 2) m
-    totals = np.add.reduceat(plan.weights * (2.0 * gamma * gamma + 4.0 * mean2 * gamma), plan.starts)
+    totals = np.add.reduceat(plan.weights * summand(gamma, mean2), plan.starts)
     out = np.empty((factors.size, factors.size))
     out[plan.j, plan.k] = out[plan.k, plan.j] = totals / plan.norms
     return out
@@ -203,9 +207,9 @@ class _Plan:
 
 @functools.lru_cache(maxsize=2)
 def _lag_plan(n: int, factors: tuple[int, ...], memory: bool, memory_lags: int) -> _Plan:
-    """The nodes of :func:`level_covariance` for one length and grid (shared by every channel of a log)."""
+    """The nodes of :func:`structure_covariance` for one length and grid (shared by every channel of a log)."""
     m = np.asarray(factors, dtype=np.int64)
-    counts = n - 2 * m + 1
+    counts = level_counts(n, m)
     top = int(m.max())
     reach = min(int(counts.max()), (2 + 2 * TAIL) * 2 * top + memory_lags if memory else 2 * top + 2)
     pieces = []
@@ -219,7 +223,7 @@ def _lag_plan(n: int, factors: tuple[int, ...], memory: bool, memory_lags: int) 
             ends = np.array([mj + 1, mj - mk + 1, 1, 1 - mk])
             kinks = np.concatenate([(shifts[:, None] + ends[None, :]).ravel(), [0, count_k - count_j]])
             h, weights = _nodes(low, high, kinks)
-            pairs = np.maximum(np.minimum(count_j, count_k - h) - np.maximum(1, 1 - h) + 1, 0)
+            pairs = pair_counts(count_j, count_k, h)
             pieces.append((j, k, h, weights * pairs, float(count_j) * float(count_k)))
     lengths = np.array([p[2].size for p in pieces])
     return _Plan(h=np.concatenate([p[2] for p in pieces]),
@@ -292,7 +296,7 @@ def _interpolated(components: Sequence[Component], n: int, factors: np.ndarray) 
         return j, k, np.column_stack([(logs[j] + logs[k]) / 2.0, logs[k] - logs[j]])
 
     nu_anchor, nu = model_av(anchors), model_av(factors)
-    relative = level_covariance(components, n, anchors) / np.outer(nu_anchor, nu_anchor)
+    relative = structure_covariance(components, n, anchors) / np.outer(nu_anchor, nu_anchor)
     aj, ak, known = coordinates(anchors)
     j, k, wanted = coordinates(factors)
     values = LinearNDInterpolator(known, relative[aj, ak])(wanted)
