@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import warnings
 from decimal import Decimal
-from typing import Any
+from typing import Any, NamedTuple
 
 from avar._validation import check_freq, check_real
 
@@ -65,8 +65,22 @@ def check_confidence(value: Any, name: str = "confidence") -> float:
     return _probability(value, name, "e.g. 0.95 for 95% intervals")
 
 
+class Renamed(NamedTuple):
+    """A parameter's value and the spelling the caller gave it under."""
+
+    value: Any
+    spelling: str
+
+
+class ConfidenceLevel(NamedTuple):
+    """A confidence level and its significance, 1 - confidence (both exact to their decimal spelling)."""
+
+    confidence: float
+    significance: float
+
+
 def renamed(new: str, new_value: Any, old: str, old_value: Any, *, deprecated: bool, default: Any = None,
-            note: str = "", stacklevel: int = 3) -> tuple[Any, str]:
+            note: str = "", stacklevel: int = 3) -> Renamed:
     """The value of a parameter spelled ``new`` or, as an alias, ``old``; and the spelling the caller used.
 
     ``new_value is default`` means ``new`` was not given. Both given: a TypeError naming both.
@@ -75,17 +89,17 @@ def renamed(new: str, new_value: Any, old: str, old_value: Any, *, deprecated: b
     release that removes it.
     """
     if old_value is None:
-        return new_value, new
+        return Renamed(new_value, new)
     if new_value is not default:
         raise TypeError(f"give {new}= or {old}= (its {'deprecated ' if deprecated else ''}alias), not both")
     if deprecated:
         warnings.warn(f"{old}= is deprecated and will be removed in avar {REMOVED_IN}; use {new}= instead{note}",
                       DeprecationWarning, stacklevel=stacklevel)
-    return old_value, old
+    return Renamed(old_value, old)
 
 
 def resolve_confidence(confidence: Any, alpha: Any, *, deprecated: bool = True, stacklevel: int = 4
-                       ) -> tuple[float, float]:
+                       ) -> ConfidenceLevel:
     """(confidence, significance = 1 - confidence) of ``confidence=`` or its alias ``alpha=`` (1 - confidence).
 
     The significance is kept as given when ``alpha`` is (``alpha=1e-300`` keeps its tail;
@@ -97,9 +111,9 @@ def resolve_confidence(confidence: Any, alpha: Any, *, deprecated: bool = True, 
                           stacklevel=stacklevel)
     if used == "alpha":
         significance = _probability(value, "alpha", "1 - the confidence level, e.g. 0.05 for 95% intervals")
-        return complement(significance), significance
+        return ConfidenceLevel(complement(significance), significance)
     level = check_confidence(value)
-    return level, complement(level)
+    return ConfidenceLevel(level, complement(level))
 
 
 def deprecated_significance(confidence: float | None) -> float | None:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -75,8 +75,17 @@ def check_flag(value: Any, role: str) -> bool:
     return bool(value)
 
 
+class Style(NamedTuple):
+    """The common options of a figure, checked."""
+
+    deviation: bool
+    ci: bool
+    legend: str | None
+    markersize: float
+
+
 def check_style(deviation: Any, ci: Any, legend_position: Any, markersize: Any,
-                colours: Mapping[str, Any], texts: Mapping[str, Any]) -> tuple[bool, bool, str | None, float]:
+                colours: Mapping[str, Any], texts: Mapping[str, Any]) -> Style:
     """Validate the common options; returns deviation, ci, legend location, markersize."""
     for role, colour in colours.items():
         check_colour(colour, role)
@@ -87,7 +96,7 @@ def check_style(deviation: Any, ci: Any, legend_position: Any, markersize: Any,
         raise TypeError(f"markersize must be a number of points, got {markersize!r}")
     if not np.isfinite(markersize) or markersize < 0:
         raise ValueError(f"markersize must be finite and >= 0, got {markersize!r}")
-    return (check_flag(deviation, "deviation"), check_flag(ci, "ci"),
+    return Style(check_flag(deviation, "deviation"), check_flag(ci, "ci"),
             check_legend_position(legend_position), float(markersize))
 
 
@@ -123,7 +132,15 @@ def values_of(av: AllanVariance, deviation: bool) -> np.ndarray:
     return av.adev if deviation else av.allan
 
 
-def band(av: AllanVariance, deviation: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+class Band(NamedTuple):
+    """A result's confidence band and the levels that have one."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    valid: np.ndarray
+
+
+def band(av: AllanVariance, deviation: bool) -> Band:
     """Lower and upper band and the mask of levels that get a band.
 
     The band of the AD is [lci, uci]; that of the AV is [lci**2, uci**2].
@@ -134,7 +151,7 @@ def band(av: AllanVariance, deviation: bool) -> tuple[np.ndarray, np.ndarray, np
     valid = np.isfinite(lower) & np.isfinite(upper) & (lower > 0)
     if not deviation:
         lower, upper = lower**2, upper**2
-    return lower, upper, valid
+    return Band(lower, upper, valid)
 
 
 def band_label(av: AllanVariance, name: str) -> str:

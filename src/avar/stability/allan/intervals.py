@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -41,8 +41,17 @@ def check_ci(ci: Any, confidence: Any) -> tuple[str, float | None]:
     return ci, float(confidence)
 
 
+class Chi2Band(NamedTuple):
+    """The noise exponent, EDF and chi-squared bounds of one series' Allan deviation, level by level."""
+
+    alpha: np.ndarray
+    edf: np.ndarray
+    lci: np.ndarray
+    uci: np.ndarray
+
+
 def chi2_band(column: np.ndarray, factors: np.ndarray, freq: float, type: str, allan: np.ndarray,
-              confidence: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+              confidence: float) -> Chi2Band:
     """alpha, edf, lci, uci of the Allan deviation sqrt(allan) of one series.
 
     The series is taken as frequency data y: its phase is x = (0, cumsum(y)) / freq
@@ -56,4 +65,4 @@ def chi2_band(column: np.ndarray, factors: np.ndarray, freq: float, type: str, a
     alpha = identify_noise(phase, factors, estimator, from_frequency=True)
     edf = estimator_edf(estimator, alpha, factors, phase.size)
     lci, uci = chi2_bounds(np.sqrt(allan), edf, confidence)
-    return alpha, edf, lci, uci
+    return Chi2Band(alpha, edf, lci, uci)
