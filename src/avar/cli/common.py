@@ -119,16 +119,20 @@ def format_table(frame: pd.DataFrame, index: bool = False) -> str:
     return frame.to_string(index=index, float_format=FLOAT_FORMAT)
 
 
-def confidence_level(text: str) -> float:
-    """``--confidence``: a probability strictly between 0 and 1 (0.95 for 95 % intervals)."""
+def _probability(text: str, expected: str) -> float:
+    """``text`` as a number strictly between 0 and 1, else a usage error saying what was ``expected``."""
     try:
         value = float(text)
     except ValueError:
         value = float("nan")
     if not 0.0 < value < 1.0:
-        raise argparse.ArgumentTypeError(f"expected a confidence level, a number in (0, 1) such as 0.95, "
-                                         f"got {short_repr(text)}")
+        raise argparse.ArgumentTypeError(f"expected {expected}, got {short_repr(text)}")
     return value
+
+
+def confidence_level(text: str) -> float:
+    """``--confidence``: a probability strictly between 0 and 1 (0.95 for 95 % intervals)."""
+    return _probability(text, "a confidence level, a number in (0, 1) such as 0.95")
 
 
 def _unit_type(kind: str, option: str):
@@ -225,14 +229,7 @@ def resolve_aliases(args: argparse.Namespace) -> list[str]:
 
 def confidence_alpha(text: str) -> float:
     """``--alpha`` (deprecated): 1 - the confidence level, a number strictly between 0 and 1."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not 0.0 < value < 1.0:
-        raise argparse.ArgumentTypeError(f"expected 1 - the confidence level, a number in (0, 1) such as 0.05, "
-                                         f"got {short_repr(text)}")
-    return value
+    return _probability(text, "1 - the confidence level, a number in (0, 1) such as 0.05")
 
 
 def seed_number(text: str) -> int:
