@@ -10,11 +10,15 @@ compiled yet, neither in this process nor in numba's cache for this machine
 (:func:`compiled`). Once they are (``avar warmup``, a long record, an earlier run), the
 kernels run, as fast as before. A process that keeps calling turns hot: once a dispatch
 has spent :data:`HOT_WORK` units in its twin (about a second), it compiles its kernels
-after all, and is fast from then on (and so are later processes, from numba's cache). The dispatching points: the deviation family's phase and
-levels (:func:`avar.stability.classic.core.numpy_levels`, twin
-:mod:`avar.stability.classic.small`), its noise identification
-(:mod:`avar.stability.uncertainty.lag1`), the scan of the data
-(:func:`avar._kernels.classic.phase.scan`) and the Allan variance
+after all, and is fast from then on (and so are later processes, from numba's cache).
+The two paths agree to about 1e-15 (the tests ask 1e-12): the last bits of a result may
+differ between a cold and a warm run, as they do between CPUs.
+
+The dispatching points: the deviation family's phase and levels
+(:func:`avar.stability.classic.core.numpy_levels`, twin :mod:`avar.stability.classic.small`),
+its noise identification (:mod:`avar.stability.uncertainty.lag1`), the scan of the data
+(:func:`avar._kernels.classic.phase.scan`), Greenhall's EDF sums
+(:func:`avar._kernels.uncertainty.edf.greenhall_sums`) and the Allan variance
 (:func:`avar.stability.allan.columns.numpy_columns`). Where a twin cannot certify its
 result (adversarial data), or cannot apply (gaps), the kernels run whatever this says.
 
@@ -63,6 +67,8 @@ _COMPILED: set[tuple] = set()
 _NOT_CACHED: set[tuple] = set()
 #: Work spent in the twins so far, by the kernels they stood in for.
 _SPENT: dict[tuple, int] = {}
+#: Callers' routes whose kernels were found compiled (a dispatch then costs one set lookup).
+_WARM_ROUTES: set = set()
 
 
 def _type_key(argument: object) -> object:
@@ -111,12 +117,13 @@ def compiled(kernels: tuple, argument: object = None) -> bool:
 
 
 def numpy_path(work: int | Callable[[], int], limit: int, kernels: tuple | Callable[[], tuple] = (),
-               argument: object = None, fits: bool = True) -> bool:
+               argument: object = None, fits: bool = True, route: object = None) -> bool:
     """Whether a call of ``work`` units (samples, terms) takes the NumPy twin: forced, or its
     work is within ``limit`` (and ``fits``, the caller's other size limits, holds),
     ``kernels`` are not :func:`compiled` yet (for ``argument``) and the twins standing in
     for them have spent less than :data:`HOT_WORK` in this process. ``work`` and ``kernels``
-    may be callables, evaluated only when needed (warm kernels cost a set lookup).
+    may be callables, evaluated only when needed; ``route``, a hashable that determines
+    ``kernels`` and their argument types, skips even that once they were found compiled.
 
     >>> from numba import njit
     >>> cold = njit(lambda x: x)
@@ -130,10 +137,12 @@ def numpy_path(work: int | Callable[[], int], limit: int, kernels: tuple | Calla
     mode = path_mode()
     if mode != "auto":
         return mode == "numpy"
-    if not fits:
+    if not fits or (route is not None and route in _WARM_ROUTES):
         return False
     kernels = kernels() if callable(kernels) else kernels
     if compiled(kernels, argument):
+        if route is not None:
+            _WARM_ROUTES.add(route)
         return False
     work = work() if callable(work) else work
     if work > limit:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from avar import _kernels
-from avar._kernels.allan.columns import column_kernels
+from avar._kernels.allan.columns import SMALL_MAX, column_kernels
 from avar._kernels.runtime.paths import numpy_path
 from avar._validation import check_finite
 from avar.stability.classic.small import level_sums
@@ -34,6 +34,18 @@ def _exact_float64(x: np.ndarray) -> np.ndarray | None:
     return None
 
 
+def _octave(factors: np.ndarray) -> bool:
+    f = np.asarray(factors, dtype=np.int64)
+    return bool(np.all((f & (f - 1)) == 0))
+
+
+def _differences(n: int, factors: np.ndarray, is_mo: bool) -> int:
+    """The differences of every valid level, and one per sample (the NumPy path's work)."""
+    f = np.asarray(factors, dtype=np.int64).reshape(-1)
+    counts = n - 2 * f + 1 if is_mo else n // np.maximum(f, 1) - 1
+    return int(counts[(f >= 1) & (counts > 0)].sum()) + n
+
+
 def numpy_columns(data: np.ndarray, factors: np.ndarray, type: str) -> np.ndarray | None:
     """:func:`allan_variance_columns` by NumPy (:mod:`avar.stability.classic.small`: the Allan
     variance of a series is OADEV**2 ("mo") or ADEV**2 ("to") of it as frequency data): for
@@ -48,19 +60,19 @@ def numpy_columns(data: np.ndarray, factors: np.ndarray, type: str) -> np.ndarra
     [[1.25, 0.5]]
     """
     x = np.asarray(data)
-    x = x[:, None] if x.ndim == 1 else x
-    if x.ndim != 2:
+    if x.ndim == 1:
+        x = x[:, None]
+    elif x.ndim != 2:
         return None
     n, channels = x.shape
-    f = np.asarray(factors, dtype=np.int64).reshape(-1)
     is_mo = type == "mo"
-
-    def differences() -> int:
-        counts = n - 2 * f + 1 if is_mo else n // np.maximum(f, 1) - 1
-        return int(counts[(f >= 1) & (counts > 0)].sum()) + n
-
-    if not numpy_path(differences, NUMPY_DIFFERENCES, lambda: column_kernels(x, f, type), fits=n <= NUMPY_SAMPLES):
+    flags = x.flags  # what the kernels' route and argument types depend on
+    route = ("allan", x.dtype.str, flags.c_contiguous, flags.f_contiguous, flags.aligned, type, n <= SMALL_MAX,
+             is_mo or n <= SMALL_MAX or _octave(factors))
+    if not numpy_path(lambda: _differences(n, factors, is_mo), NUMPY_DIFFERENCES,
+                      lambda: column_kernels(x, factors, type), fits=n <= NUMPY_SAMPLES, route=route):
         return None
+    f = np.asarray(factors, dtype=np.int64).reshape(-1)
     counts = n - 2 * f + 1 if is_mo else n // np.maximum(f, 1) - 1
     valid = (f >= 1) & (counts > 0)
     values = _exact_float64(x)
