@@ -8,6 +8,7 @@ finding.
 
 from __future__ import annotations
 
+import ast
 import json
 import re
 import shutil
@@ -147,3 +148,137 @@ def test_ruff_is_clean():
         pytest.skip("ruff is not installed (the test extra installs it)")
     result = subprocess.run([ruff, "check", str(ROOT)], capture_output=True, text=True)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+# --------------------------------------------------------------------------- named values between modules
+#: Functions that still hand a positional tuple to another module, each with its reason. Keep it short.
+TUPLE_RETURNS_ALLOWED = {
+    "avar._kernels.dd.two_sum": "the (sum, rounding error) pair of Knuth's error-free TwoSum, unpacked at once in "
+                                "the innermost compensated loops of the allan and classic kernels",
+    "avar._kernels.dd.fast_two_sum": "Dekker's FastTwoSum: as two_sum",
+}
+#: Still to convert by their owners (issue 37); remove each entry with its conversion.
+TUPLE_RETURNS_PENDING = {
+    f"avar._kernels.{name}": "kernels of the allan, classic and uncertainty families, converted separately"
+    for name in ("allan.blocks.block_table", "allan.blocks.point", "allan.blocks.window_level_sums",
+                 "allan.columns.column_kernels", "allan.far_steps.table_base", "allan.haar.haar_sums",
+                 "classic.levels.level_sums", "classic.phase.phase_increment", "classic.phase.scan",
+                 "uncertainty.noise_id.lag1_kernels")
+} | {
+    "avar.plotting.masks.mask_line": "new this round, read by plotting/deviation.py",
+}
+
+
+def _tuple_valued(node: ast.expr, tuple_functions: set[str]) -> bool:
+    """A tuple display of two or more items, either branch of ``a if c else b`` being one, or a
+    call of a function of the same module that returns one."""
+    if isinstance(node, ast.Tuple):
+        return len(node.elts) >= 2
+    if isinstance(node, ast.IfExp):
+        return _tuple_valued(node.body, tuple_functions) or _tuple_valued(node.orelse, tuple_functions)
+    return isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in tuple_functions
+
+
+def _own_returns(function: ast.FunctionDef | ast.AsyncFunctionDef):
+    """The return statements of ``function`` itself, not of the functions and classes nested in it."""
+    stack = list(function.body)
+    while stack:
+        node = stack.pop()
+        if isinstance(node, ast.Return) and node.value is not None:
+            yield node.value
+        if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
+            stack.extend(ast.iter_child_nodes(node))
+
+
+def _tuple_functions(tree: ast.Module) -> set[str]:
+    """Top-level functions returning a positional tuple: a tuple display, or annotated
+    ``-> tuple[X, Y]`` (``tuple[X, ...]``, a sequence of one kind, is not positional)."""
+    functions = [node for node in tree.body if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))]
+    annotated = {f.name for f in functions if f.returns is not None and "..." not in ast.unparse(f.returns)
+                 and re.match(r"(typing\.)?[Tt]uple\[", ast.unparse(f.returns))}
+    found: set[str] = set()
+    while True:  # to a fixed point: ``return other(...)`` of a tuple-returning function of the module
+        grown = annotated | {f.name for f in functions if any(_tuple_valued(v, found) for v in _own_returns(f))}
+        if grown == found:
+            return found
+        found = grown
+
+
+def positional_tuples_between_modules(sources: dict[str, tuple[str, bool]]) -> dict[str, set[str]]:
+    """``{"module.function": modules that import it}`` for every function returning a positional
+    tuple that another module imports. ``sources``: module name -> (source, is a package's
+    ``__init__``). Imports are followed through re-exports, ``from package import module``
+    (``module.function``) and ``import a.b as m`` (``m.function``), at any depth of the module."""
+    trees = {name: ast.parse(text) for name, (text, _) in sources.items()}
+    tuples = {name: _tuple_functions(tree) for name, tree in trees.items()}
+
+    def resolve(module: str, node: ast.ImportFrom) -> str:
+        if not node.level:
+            return node.module or ""
+        parts = module.split(".")
+        parts = parts[: len(parts) - node.level + sources[module][1]]
+        return ".".join(parts + ([node.module] if node.module else []))
+
+    def origin(module: str, name: str, seen: frozenset = frozenset()) -> str | None:
+        if name in tuples.get(module, ()):
+            return f"{module}.{name}"
+        if module not in trees or (module, name) in seen:
+            return None
+        for node in trees[module].body:  # a re-export
+            if isinstance(node, ast.ImportFrom):
+                for alias in node.names:
+                    if (alias.asname or alias.name) == name:
+                        return origin(resolve(module, node), alias.name, seen | {(module, name)})
+        return None
+
+    found: dict[str, set[str]] = {}
+    for module, tree in trees.items():
+        names, modules = [], {}  # imported (source module, name); local name -> imported module
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                source = resolve(module, node)
+                for alias in node.names:
+                    names.append((source, alias.name))
+                    if f"{source}.{alias.name}" in trees:
+                        modules[alias.asname or alias.name] = f"{source}.{alias.name}"
+            elif isinstance(node, ast.Import):
+                for alias in node.names:
+                    modules[alias.asname or alias.name] = alias.name
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute):
+                target = modules.get(node.value.id) if isinstance(node.value, ast.Name) else None
+                names.append((target or ast.unparse(node.value), node.attr))
+        for source, name in names:
+            function = origin(source, name)
+            if function is not None and function.rsplit(".", 1)[0] != module:
+                found.setdefault(function, set()).add(module)
+    return found
+
+
+def test_tuple_finder_finds_a_planted_positional_tuple():
+    sources = {
+        "pkg": ("from .a import pair\n", True),
+        "pkg.a": ("from typing import NamedTuple\nclass P(NamedTuple):\n    a: int\n    b: int\n"
+                  "def pair(x):\n    return (x, x) if x else _pair(x)\ndef _pair(x):\n    return x, 1\n"
+                  "def named(x):\n    return P(x, x)\ndef annotated(x) -> tuple[int, int]:\n    return _pair(x)\n"
+                  "def many(x) -> tuple[int, ...]:\n    return tuple(x)\ndef used_here():\n    return pair(1)\n", False),
+        "pkg.b": ("from pkg import pair\nfrom . import a\nimport pkg.a as alias\n"
+                  "def f():\n    return pair(1), a.named(2), a.many(3), alias.annotated(4)\n", False),
+        "pkg.c": ("def g():\n    from .a import _pair\n    return _pair(1)\n", False),
+    }
+    assert positional_tuples_between_modules(sources) == {
+        "pkg.a.pair": {"pkg", "pkg.b"}, "pkg.a.annotated": {"pkg.b"}, "pkg.a._pair": {"pkg.c"}}
+
+
+def test_values_travel_between_modules_as_named_tuples():
+    """A function whose callers live in other modules returns a NamedTuple or a dataclass, not a
+    positional tuple (docs/architecture.md); the allow-lists hold the exceptions, with their reasons."""
+    sources = {}
+    for path in PACKAGE.rglob("*.py"):
+        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        package = parts[-1] == "__init__"
+        sources[".".join(parts[:-1] if package else parts)] = (path.read_text(), package)
+    found = positional_tuples_between_modules(sources)
+    allowed = TUPLE_RETURNS_ALLOWED | TUPLE_RETURNS_PENDING
+    assert {name: sorted(callers) for name, callers in found.items() if name not in allowed} == {}
+    assert sorted(set(allowed) - set(found)) == [], "converted: remove these from the allow-lists"

@@ -34,7 +34,7 @@ RATE_PENDING: dict[str, str] = {}
 #: Results with levels, and the class that holds them.
 RESULTS_WITH_TAUS = ["AllanVariance", "ImuAllanVariance", "RobustAllanVariance", "Deviation", "AvlrResult",
                      "ImuAvlrResult", "GmwmResult", "ImuGmwmResult", "AutoScales"]
-HIDDEN_ALIASES = {"--freq", "--alpha", "--units"}
+HIDDEN_ALIASES = {"--freq", "--alpha", "--units", "--kalibr-axis"}
 SECTION = re.compile(r"^(?P<indent>[ \t]*)(?P<title>Parameters|Attributes|Other Parameters)\n(?P=indent)-{3,}\n", re.M)
 
 
@@ -293,8 +293,8 @@ def subparsers() -> dict[str, argparse.ArgumentParser]:
 
 SUBPARSERS = subparsers()
 #: Subcommands that take a sampling rate, a confidence level, data units.
-TAKES_RATE = {"compute", "fit", "report", "deviation"}
-TAKES_CONFIDENCE = {"fit", "report", "deviation"}
+TAKES_RATE = {"compute", "fit", "report", "deviation", "clock-report", "simulate"}
+TAKES_CONFIDENCE = {"fit", "report", "deviation", "clock-report"}
 TAKES_UNITS = {"compute", "fit", "report"}
 
 

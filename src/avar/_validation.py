@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import numbers
 import sys
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
+
+from avar._time_steps import rate_from_index
 
 MIN_SAMPLES = 4
 
@@ -93,9 +95,22 @@ def as_array(x: Any, what: str) -> np.ndarray:
         ) from None
 
 
-def integer_range(array: np.ndarray) -> tuple[int, int] | None:
-    """(min, max) of an integer array as Python ints, or None for other dtypes."""
-    return None if array.dtype.kind not in "iu" or array.size == 0 else (int(array.min()), int(array.max()))
+class IntegerRange(NamedTuple):
+    """The smallest and largest value of an integer array, as Python ints (exact beyond 2**53)."""
+
+    minimum: int
+    maximum: int
+
+
+def integer_range(array: np.ndarray) -> IntegerRange | None:
+    """:class:`IntegerRange` of an integer array, or None for other dtypes and empty arrays.
+
+    >>> integer_range(np.array([3, -2**62, 7]))
+    IntegerRange(minimum=-4611686018427387904, maximum=7)
+    """
+    if array.dtype.kind not in "iu" or array.size == 0:
+        return None
+    return IntegerRange(int(array.min()), int(array.max()))
 
 
 def as_float64(array: np.ndarray) -> np.ndarray:
@@ -108,11 +123,11 @@ def as_float64(array: np.ndarray) -> np.ndarray:
     without loss: they are returned unchanged, as integers, for the kernels.
     """
     bounds = integer_range(array)
-    if bounds is None or max(abs(bounds[0]), abs(bounds[1])) <= EXACT_INTEGER_LIMIT:
+    if bounds is None or max(abs(bounds.minimum), abs(bounds.maximum)) <= EXACT_INTEGER_LIMIT:
         return np.ascontiguousarray(array, dtype=np.float64)
-    if bounds[1] - bounds[0] >= EXACT_INTEGER_LIMIT:
+    if bounds.maximum - bounds.minimum >= EXACT_INTEGER_LIMIT:
         return np.ascontiguousarray(array)
-    offset = (bounds[0] + bounds[1]) // 2
+    offset = (bounds.minimum + bounds.maximum) // 2
     if array.dtype.kind == "i":
         return (array - np.int64(offset)).astype(np.float64)
     above = array >= np.uint64(offset)
@@ -193,118 +208,6 @@ def check_length(n: int, what: str) -> None:
         raise ValueError(f"{what} has {n} sample(s); the Allan variance needs at least {MIN_SAMPLES}")
 
 
-#: A time step longer than this many median steps is a gap.
-GAP_FACTOR = 1.5
-
-
-def analyze_steps(steps: np.ndarray) -> tuple[float, float, float, np.ndarray]:
-    """Rate, median step, jitter and gaps of the time steps (s) of a recording.
-
-    The median step locates the gaps: steps longer than ``GAP_FACTOR`` median steps. The
-    step is then the least-squares slope of time against sample number, pooled over the
-    stretches between gaps: the rounding of stamps (a 300 Hz log stamped to the
-    millisecond steps 3, 3, 4 ms) biases the median step (333 Hz) and barely moves the
-    slope. The rate is 1 / that step; the jitter is the root mean square of the
-    deviations of the steps (outside gaps) from it (s).
-
-    Returns
-    -------
-    rate : float
-        Hz.
-    median : float
-        The median step (s).
-    jitter : float
-        s, rms.
-    gaps : ndarray of int
-        0-based positions ``i`` of the gap steps (between samples ``i`` and ``i + 1``).
-
-    Raises
-    ------
-    ValueError
-        A step that is not > 0 (the message gives its position), or no step at all.
-
-    >>> rate, median, jitter, gaps = analyze_steps(np.diff(np.round(np.arange(3000) / 0.3)) / 1000)
-    >>> round(rate, 2), median, round(jitter * 1e3, 3), gaps.size
-    (300.0, 0.003, 0.471, 0)
-    """
-    steps = np.asarray(steps, dtype=np.float64)
-    if steps.size == 0:
-        raise ValueError("a time axis needs at least two samples")
-    bad = ~(steps > 0)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise ValueError(
-            f"time does not increase strictly: sample {i + 2} is at {steps[i]:+.6g} s from sample {i + 1}"
-            f"{f' ({int(bad.sum())} such steps)' if bad.sum() > 1 else ''}; sort the samples or drop duplicate times"
-        )
-    median = float(np.median(steps))
-    is_gap = steps > GAP_FACTOR * median
-    times = np.concatenate([[0.0], np.cumsum(steps)])
-    segment = np.concatenate([[0], np.cumsum(is_gap)])
-    counts = np.bincount(segment).astype(np.float64)
-    number = np.arange(times.size, dtype=np.float64)
-    d_number = number - (np.bincount(segment, number) / counts)[segment]
-    d_time = times - (np.bincount(segment, times) / counts)[segment]
-    spread = float(d_number @ d_number)
-    step = float(d_number @ d_time) / spread if spread > 0 else float(steps[~is_gap].mean())
-    regular = steps[~is_gap]
-    jitter = float(np.sqrt(np.mean((regular - step) ** 2)))
-    return 1.0 / step, median, jitter, np.flatnonzero(is_gap)
-
-
-def describe_gaps(gaps: np.ndarray, steps: np.ndarray, median: float, seconds_at) -> str:
-    """'3 gap(s) (steps > 1.5 x the median step 5 ms); the first after sample 1200 (t = 6 s), 0.5 s long'.
-
-    ``seconds_at(i)`` gives the time (s from the first sample) of 0-based sample ``i``.
-    """
-    first = int(gaps[0])
-    return (
-        f"{gaps.size} gap(s) (time steps > {GAP_FACTOR:g} x the median step {median:.6g} s); the first is between "
-        f"samples {first + 1} and {first + 2} (row {first + 2} at t = {seconds_at(first + 1):.6g} s), "
-        f"a step of {float(steps[first]):.6g} s"
-    )
-
-
-def _rate_from_seconds(seconds: np.ndarray, what: str) -> float:
-    steps = np.diff(seconds)
-    try:
-        rate, median, _, gaps = analyze_steps(steps)
-    except ValueError as error:
-        raise ValueError(f"{what} has a time index where {error}") from None
-    if gaps.size:
-        origin = seconds[0]
-        message = describe_gaps(gaps, steps, median, lambda i: seconds[i] - origin)
-        raise ValueError(f"{what} has a time index with {message}; fill or cut them, or pass the sampling rate explicitly")
-    return rate
-
-
-def rate_from_index(index: Any, what: str) -> float | None:
-    """Sampling rate (Hz) of a time index: regular Datetime/Timedelta, Period, or float seconds.
-
-    A float index holds times in seconds: its rate is 1 / the mean step (see
-    :func:`analyze_steps`; timestamp rounding and jitter are accepted, gaps are not).
-    A PeriodIndex gives the rate of its periods. Returns None for other indexes (a
-    RangeIndex or integer index numbers samples, it does not time them); raises
-    ValueError for an irregular Datetime/Timedelta index or a float index with gaps.
-    """
-    import pandas as pd  # an index is a pandas object: pandas is loaded already
-    if isinstance(index, pd.PeriodIndex) and len(index) >= 2:
-        index = index.to_timestamp()
-    if index.dtype.kind == "f" and len(index) >= 2:
-        return _rate_from_seconds(index.to_numpy(dtype=np.float64), what)
-    if not isinstance(index, (pd.DatetimeIndex, pd.TimedeltaIndex)) or len(index) < 2:
-        return None
-    steps = np.diff((index.tz_convert(None) if getattr(index, "tz", None) else index).to_numpy())  # own unit
-    unit, count = np.datetime_data(steps.dtype)
-    steps = steps.astype(np.int64)
-    if np.any(steps <= 0):
-        raise ValueError(f"{what} has a time index that does not increase strictly; sort it or drop duplicate times")
-    if np.any(steps != steps[0]):
-        raise ValueError(f"{what} has an irregular time index (steps from {steps.min() * count} to "
-                         f"{steps.max() * count} {unit}); resample it to a regular grid or pass the sampling rate explicitly")
-    return 1.0 / (float(steps[0]) * (np.timedelta64(count, unit) / np.timedelta64(1, "s")))
-
-
 def native_values(array: np.ndarray) -> np.ndarray | None:
     """``array`` itself when the kernels read it as it is, else None: integers, booleans, float32/64
     (magnitudes near the float64 limit are the kernels' to rescale). A non-finite value is not looked
@@ -316,8 +219,17 @@ def native_values(array: np.ndarray) -> np.ndarray | None:
     return None
 
 
-def as_series(x: Any, freq: Any, native: bool = False, rate_name: str = "freq") -> tuple[np.ndarray, float]:
-    """Validate a 1-D series and its rate; return float64 values and the rate (Hz).
+class ValidSeries(NamedTuple):
+    """A validated 1-D series (:func:`as_series`)."""
+
+    #: The samples: float64, or the caller's integers, booleans or float32 with ``native=True``.
+    values: np.ndarray
+    #: Sampling rate (Hz).
+    rate: float
+
+
+def as_series(x: Any, freq: Any, native: bool = False, rate_name: str = "freq") -> ValidSeries:
+    """Validate a 1-D series and its rate; return the :class:`ValidSeries` of values and rate (Hz).
 
     Integers spanning 2**53 or more are returned as integers (see :func:`as_float64`).
     ``native=True`` (for kernels that read any real dtype in place) returns integer, boolean and
@@ -348,7 +260,7 @@ def as_series(x: Any, freq: Any, native: bool = False, rate_name: str = "freq") 
         rate = index_rate if index_rate is not None else 1.0
     else:
         rate = check_freq(freq, rate_name)
-    return values, rate
+    return ValidSeries(values, rate)
 
 
 def check_whole_numbers(values: Any, name: str) -> np.ndarray:

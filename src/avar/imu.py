@@ -21,6 +21,7 @@ if TYPE_CHECKING:  # pandas loads only for frames and Series
     import pandas as pd
 
 from avar._escape import terminal
+from avar._time_steps import rate_from_index
 from avar._validation import (
     EXACT_INTEGER_LIMIT,
     as_array,
@@ -28,7 +29,6 @@ from avar._validation import (
     check_length,
     check_numeric_dtype,
     integer_range,
-    rate_from_index,
 )
 from avar._vocabulary import check_rate, renamed
 
@@ -58,7 +58,7 @@ def _frozen_matrix(values: np.ndarray) -> np.ndarray:
     :func:`avar._validation.as_float64`).
     """
     bounds = integer_range(np.asarray(values))
-    lossy = bounds is not None and max(abs(bounds[0]), abs(bounds[1])) > EXACT_INTEGER_LIMIT
+    lossy = bounds is not None and max(abs(bounds.minimum), abs(bounds.maximum)) > EXACT_INTEGER_LIMIT
     matrix = np.array(values, dtype=np.asarray(values).dtype if lossy else np.float64, order="F", copy=True)
     matrix.flags.writeable = False
     return matrix

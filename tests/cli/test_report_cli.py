@@ -109,7 +109,7 @@ def test_curves_minimum_rows_and_kalibr_without_a_random_walk(tmp_path):
     assert set(fields) == {"gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
                            "accelerometer_random_walk", "rostopic", "update_rate"}
     assert all(isinstance(fields[k], float) and fields[k] > 0 for k in fields if k != "rostopic")
-    assert text.count("95 % upper bound") >= 2 and "mean over the axes" in text
+    assert text.count("one-sided 97.5 % upper bound") >= 2 and "mean over the axes" in text
     assert fields["gyroscope_noise_density"] == pytest.approx(0.01 / math.sqrt(FREQ), rel=0.05)
     table = pd.read_csv(curves)
     assert list(table.columns[:6]) == ["Channel", "Tau (s)", "ADEV", "Lower", "Upper", "Implied ADEV"]

@@ -247,7 +247,7 @@ def _report(source=None):
 
 
 def test_write_kalibr_mode_follows_the_umask(tmp_path):
-    from avar.fit.report.kalibr import write_kalibr
+    from avar.fit.report.exports.kalibr import write_kalibr
 
     old = os.umask(0o027)
     try:
@@ -260,7 +260,7 @@ def test_write_kalibr_mode_follows_the_umask(tmp_path):
 
 
 def test_write_kalibr_refuses_nan_fifos_and_names_the_target(tmp_path):
-    from avar.fit.report.kalibr import write_kalibr
+    from avar.fit.report.exports.kalibr import write_kalibr
 
     with pytest.raises(ValueError, match=r"\['gyroscope_noise_density'\] are not finite numbers"):
         write_kalibr(_report(), tmp_path / "a.yaml", gyroscope_noise_density=float("nan"))

@@ -154,3 +154,93 @@ def test_warnings_and_curves_are_rendered_when_the_report_has_them():
     plain.feed(report_html(report, figures=[]))
     assert plain.tables["curves"][0][:6] == ["Channel", "Tau (s)", "ADEV", "Lower", "Upper", "Implied ADEV"]
     assert len(plain.tables["curves"]) == len(report.curves) + 1 and "none" in "".join(plain.text)
+
+
+#: Measures the page as Chromium lays it out at 1,280 px, every <details> opened, and writes the figures
+#: into the DOM (read back with --dump-dom): the page's scroll width, each table's right edge and
+#: overflow, and the tops of the summary table, the figure and the first <details>.
+LAYOUT_SCRIPT = """<pre id="layout"></pre><script>
+document.querySelectorAll("details").forEach(d => { d.open = true; });
+const topOf = el => el ? Math.round(el.getBoundingClientRect().top + window.scrollY) : null;
+const tables = [...document.querySelectorAll("table")].map(t => ({
+  name: t.className, right: Math.round(t.getBoundingClientRect().right), overflow: t.scrollWidth - t.clientWidth}));
+const svg = document.querySelector("figure svg");
+document.getElementById("layout").textContent = JSON.stringify({
+  viewport: window.innerWidth, scrollWidth: document.documentElement.scrollWidth, tables: tables,
+  summary: topOf(document.querySelector("table.summary")), figure: topOf(document.querySelector("figure")),
+  details: topOf(document.querySelector("details")),
+  svgRight: svg ? Math.round(svg.getBoundingClientRect().right) : null});
+</script></body>"""
+
+
+def layout(page, tmp_path, width=1280) -> dict:
+    """The layout figures of ``page`` in headless Chromium at ``width`` px (see LAYOUT_SCRIPT)."""
+    import json
+
+    probe = page.with_name(page.stem + "-probe.html")
+    probe.write_text(page.read_text(encoding="utf-8").replace("</body>", LAYOUT_SCRIPT), encoding="utf-8")
+    out = subprocess.run([chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                          "--no-first-run", "--disable-background-networking", "--disable-component-update",
+                          "--disable-sync", f"--user-data-dir={tmp_path / 'chromium-profile'}",
+                          f"--window-size={width},900", "--virtual-time-budget=5000", "--dump-dom", probe.as_uri()],
+                         capture_output=True, text=True, timeout=180)
+    assert out.returncode == 0, out.stderr[-2000:]
+    found = re.search(r'<pre id="layout">(.*?)</pre>', out.stdout, re.S)
+    assert found and found.group(1), out.stdout[-2000:]
+    return json.loads(found.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+
+
+def test_page_reads_top_down_and_fits_a_1280_px_window(tmp_path):
+    chromium()
+    log = tmp_path / "imu.csv"
+    write_log(log)
+    page, shot = tmp_path / "report.html", tmp_path / "report.png"
+    page.write_text(report_html(avar.noise_report(avar.read(log)), command="avar report imu.csv --html report.html"),
+                    encoding="utf-8")  # the page `avar report --html` writes (the test above runs the command)
+    source = page.read_text(encoding="utf-8")
+    assert "<details open" not in source  # the long tables start folded
+    found = layout(page, tmp_path)
+    assert found["viewport"] == 1280
+    assert found["scrollWidth"] <= 1280, found  # no horizontal scrolling
+    assert [t["name"] for t in found["tables"]] == ["summary", "terms", "curves"]
+    for table in found["tables"]:
+        assert table["right"] <= 1280 and table["overflow"] <= 0, table  # every table within the page, unfolded
+    assert found["svgRight"] <= 1280
+    assert found["summary"] < found["figure"] < found["details"], found  # summary, figure, then the details
+    # the negative control: the same probe sees a page that is too wide
+    wide = tmp_path / "wide.html"
+    wide.write_text('<!DOCTYPE html><html><body><table class="summary"><tr><td style="min-width:2000px">x</td>'
+                    "</tr></table></body></html>")
+    assert layout(wide, tmp_path)["scrollWidth"] > 1280
+    # a person's view: the screenshot at 1,280 px is written, 1,280 px wide
+    out = subprocess.run([chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                          f"--user-data-dir={tmp_path / 'chromium-profile'}", "--window-size=1280,2000",
+                          f"--screenshot={shot}", page.as_uri()], capture_output=True, text=True, timeout=180)
+    assert out.returncode == 0, out.stderr[-2000:]
+    header = shot.read_bytes()[:24]
+    assert header[:8] == b"\x89PNG\r\n\x1a\n" and int.from_bytes(header[16:20], "big") == 1280
+
+
+def test_summary_table_gives_each_axis_its_terms_in_customary_units():
+    x = avar.WN.from_continuous(1e-3, RATE).simulate(30_000, seed=4)
+    report = avar.noise_report(pd.DataFrame({"gx": x, "ax": 3 * x[::-1]}), rate=RATE)
+    parsed = Page()
+    parsed.feed(report_html(report, figures=[]))
+    from avar.plotting.html_report import SUMMARY_COLUMNS
+
+    rows = parsed.tables["summary"]
+    assert rows[0] == SUMMARY_COLUMNS and [r[0] for r in rows[1:]] == ["gx", "ax"]
+    table = report.table.set_index(["Channel", "Process"])
+    n_gyro = table.loc[("gx", "WN")]
+    assert rows[1][1] == "Gyroscope"
+    assert rows[1][2].startswith(f"{float(n_gyro['Customary']):.3g} deg/sqrt(h)")  # 1e-3 rad/s/sqrt(Hz) * 60 / deg
+    assert f"[{float(n_gyro['Customary lower']):.3g}, {float(n_gyro['Customary upper']):.3g}]" in rows[1][2]
+    assert rows[2][2].startswith(f"{float(table.loc[('ax', 'WN'), 'Customary']):.3g} m/s/sqrt(h)")
+    for row, channel in zip(rows[1:], ("gx", "ax")):
+        bias = table.loc[(channel, "FN")]
+        if bias["Status"] == "bound":
+            assert row[3].startswith(f"< {float(bias['Customary upper']):.3g} ") and row[3].endswith(bias["Note"])
+        minimum = table.loc[(channel, "MIN")]
+        assert f"at tau = {float(minimum['Tau (s)']):.3g} s" in row[5]
+        fits = report.curves.loc[report.curves["Channel"] == channel, "Fits"]
+        assert row[6] == f"fits {int(fits.sum())} of {len(fits)} levels"

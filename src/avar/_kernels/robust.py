@@ -10,8 +10,18 @@ One pass of each is O(N).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
+
+
+class IntactSquares(NamedTuple):
+    """Sum of the squared differences D_t**2 that hold no flagged sample, and their count
+    (:func:`intact_squares`; numba builds it in compiled code)."""
+
+    total: float
+    n_terms: int
 
 
 @njit(cache=True)
@@ -152,4 +162,4 @@ def intact_squares(x, flagged, m):
         if t + 2 * m < n:
             d += (x[t + 2 * m] - x[t + m]) - (x[t + m] - x[t])
             bad += flagged[t + 2 * m] - flagged[t]
-    return total, count
+    return IntactSquares(total, count)

@@ -6,13 +6,31 @@ count of missing values (``gaps[j]`` missing before index j, length N + 1; a
 term spanning phase points i .. i + s is skipped when ``gaps[i + s + extra] -
 gaps[i] > 0``, ``extra`` = 1 for phase data, 0 for frequency data whose
 missing value j lies between phase points j and j + 1). Every kernel returns
-the sum over the valid terms and their count per level; the callers divide.
+the sum over the valid terms and their count per level (:class:`TermSums`; MTIE
+the largest range, :class:`LargestRanges`); the callers divide. numba builds
+these named tuples in compiled code.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
+
+
+class TermSums(NamedTuple):
+    """The sum over the valid terms of every level and their count."""
+
+    sums: np.ndarray
+    n_terms: np.ndarray
+
+
+class LargestRanges(NamedTuple):
+    """MTIE's largest range of every level (0 where no window is valid) and the windows counted."""
+
+    ranges: np.ndarray
+    n_terms: np.ndarray
 
 
 @njit(cache=True)
@@ -65,7 +83,7 @@ def mtie_levels(x, m, gaps, extra):
         counts[level] = count
         if count:
             out[level] = best
-    return out, counts
+    return LargestRanges(out, counts)
 
 
 @njit(cache=True)
@@ -103,7 +121,7 @@ def tierms_levels(x, m, gaps, extra):
             total = t
         sums[level] = total
         counts[level] = count
-    return sums, counts
+    return TermSums(sums, counts)
 
 
 @njit(cache=True)
@@ -171,7 +189,7 @@ def pdev_levels(x, m, gaps, extra):
             count += 1
         sums[level] = total
         counts[level] = count
-    return sums, counts
+    return TermSums(sums, counts)
 
 
 @njit(cache=True)
@@ -203,4 +221,4 @@ def codev_levels(x1, x2, m, gaps, extra):
             count += 1
         sums[level] = total
         counts[level] = count
-    return sums, counts
+    return TermSums(sums, counts)

@@ -40,10 +40,10 @@ __all__ = ["ReadOptions", "add_input_arguments", "add_parser", "allan_of", "comp
 
 def read_from_args(args: argparse.Namespace):
     """The file named in ``args`` as a Recording or an IMU (``--gyro``/``--accel``, or a bag)."""
-    data, notes = load(args.file, ReadOptions.from_args(args))
-    for note in notes:
+    loaded = load(args.file, ReadOptions.from_args(args))
+    for note in loaded.notes:
         print(printable(note), file=sys.stderr)
-    return data
+    return loaded.data
 
 
 #: The warm-up's thread: its compilations are speculative, the first-run notice ignores them.

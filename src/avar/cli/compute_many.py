@@ -23,7 +23,7 @@ import sys
 from collections.abc import Iterable
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import pandas as pd
 
@@ -119,8 +119,18 @@ class ReadOptions:
         return {key: unit for key, unit in (("gyro", self.gyro_units), ("accel", self.accel_units)) if unit}
 
 
-def load(path: str, options: ReadOptions, progress: bool | None = None) -> tuple[Any, list[str]]:
-    """The file as a Recording or an IMU (``--gyro``/``--accel``, or a bag), and the notes for stderr."""
+class Loaded(NamedTuple):
+    """A file read for ``avar compute`` (:func:`load`)."""
+
+    #: A :class:`avar.Recording`, or an :class:`avar.IMU` (``--gyro``/``--accel``, or a bag).
+    data: Any
+    #: What the reader found (rate, units, gaps), one line each, for stderr.
+    notes: list[str]
+
+
+def load(path: str, options: ReadOptions, progress: bool | None = None) -> Loaded:
+    """The :class:`Loaded` file: a Recording or an IMU (``--gyro``/``--accel``, or a bag), and the notes
+    for stderr."""
     from avar.imu import IMU
     from avar.io.read import read
 
@@ -136,7 +146,7 @@ def load(path: str, options: ReadOptions, progress: bool | None = None) -> tuple
         nan_policy=options.nan_policy,
     )
     if isinstance(data, IMU):  # a bag: SI units by definition (check_bag_units refuses others)
-        return data, [f"{path}: {data.describe()}"]
+        return Loaded(data, [f"{path}: {data.describe()}"])
     note = data.describe().replace("(given)", f"({options.rate_option})")
     if data.time_column is None and options.rate is None:
         note += "; pass --rate for seconds"
@@ -147,8 +157,8 @@ def load(path: str, options: ReadOptions, progress: bool | None = None) -> tuple
         frame = pd.DataFrame(dict(data.columns), copy=False)
         imu = IMU(frame, data.rate, gyro=list(options.gyro) or None, accel=list(options.accel) or None,
                   name=Path(path).stem, units=options.units)
-        return imu, notes
-    return data, notes
+        return Loaded(imu, notes)
+    return Loaded(data, notes)
 
 
 #: The units of a ROS bag's sensor_msgs/Imu, by definition.

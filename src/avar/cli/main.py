@@ -1,6 +1,7 @@
 """The ``avar`` command line: the parser and the exit codes.
 
-Subcommands (one module each): ``demo``, ``compute``, ``deviation``, ``fit``, ``report``, ``datasets``.
+Subcommands (one module each): ``demo``, ``compute``, ``deviation``, ``fit``, ``report``, ``clock-report``, ``simulate``,
+``datasets``.
 Problems with the user's files end with a one-line message on stderr and exit
 code 1; usage errors with exit code 2. Nothing here computes: the subcommands
 read, call the library and write.
@@ -16,12 +17,12 @@ import threading
 import warnings
 
 from avar._validation import cap_text
-from avar.cli import compute, datasets, demo, deviation, fit, report, warmup
+from avar.cli import clock_report, compute, datasets, demo, deviation, fit, report, simulate, warmup
 from avar.cli.common import InputFileError, UsageError, printable, resolve_aliases
 from avar.cli.first_run import COMPILE_SECONDS, compile_notice
 from avar.cli.outputs import remove_pending
 
-SUBCOMMANDS = (demo, compute, deviation, fit, report, datasets, warmup)
+SUBCOMMANDS = (demo, compute, deviation, fit, report, clock_report, simulate, datasets, warmup)
 SCALE_OPTIONS = frozenset(f"--{name}{suffix}" for name, _ in fit.PROCESSES for suffix in ("", "-gyro", "-acc"))
 #: Seconds between the main thread's checks for Ctrl-C while the worker runs.
 WAIT_STEP = 0.1

@@ -22,9 +22,10 @@ from avar.cli.common import (
     variables_note,
 )
 from avar.cli.compute import FILE_HELP, add_output_arguments, add_reading_arguments
-from avar.cli.compute_many import check_bag_units
+from avar.cli.compute_many import add_cluster_arguments, check_bag_units
 from avar.cli.outputs import check_output_path, csv_text, plan_outputs
 from avar.cli.outputs import report as print_outputs
+from avar.cli.simulate import add_recheck_arguments, print_recheck
 
 
 def read_recording(args: argparse.Namespace):
@@ -52,6 +53,11 @@ def read_recording(args: argparse.Namespace):
     return data, notes, args.topic
 
 
+def _is_folder(file: str) -> bool:
+    """A folder of logs (not a ROS 2 bag folder, which holds metadata.yaml)."""
+    return Path(file).is_dir() and not (Path(file) / "metadata.yaml").is_file()
+
+
 def _is_bag(file: str) -> bool:
     from avar.io.read import BAG_SUFFIXES
 
@@ -61,6 +67,16 @@ def _is_bag(file: str) -> bool:
 def run(args: argparse.Namespace) -> int:
     from avar.fit.report.noise_report import noise_report
 
+    axis_and_inflate(args)
+    if len(args.file) > 1 or args.workers is not None or args.scheduler is not None or _is_folder(args.file[0]):
+        from avar.cli.report_many import run_many
+
+        if args.export:
+            raise UsageError("--export writes one log's report; with several logs, give one log per run")
+        if args.recheck is not None:
+            raise UsageError("--recheck rechecks the report of one log; with several logs, give one log per run")
+        return run_many(args)
+    args.file = args.file[0]
     inputs = [Path(args.file)]
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=[args.file], force=args.force)
     for option in ("--kalibr", "--curves", "--html"):
@@ -70,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
     for option, value in (("--kalibr", args.kalibr), ("--curves", args.curves), ("--html", args.html)):
         if value is not None:
             outputs[option] = check_output_path(option, value, inputs, args.force)
+    exports = export_outputs(args, inputs, outputs)
     taken = [p.resolve() for p in (plan.csv, plan.figure) if isinstance(p, Path)]
     for option, path in outputs.items():
         if path.resolve() in taken:
@@ -86,19 +103,71 @@ def run(args: argparse.Namespace) -> int:
                           gyro=args.gyro, accel=args.accel, confidence=args.confidence, name=Path(args.file).name,
                           source=str(args.file), topic=topic, from_bag=_is_bag(args.file), robust=args.robust)
     renders = {
-        "--kalibr": lambda: report.kalibr_text(axis=args.kalibr_axis).encode("utf-8"),
+        "--kalibr": lambda: report.kalibr_text(axis=args.axis, inflate=args.inflate).encode("utf-8"),
         "--curves": lambda: csv_text(report.curves).encode("utf-8"),
         "--html": lambda: _html(report, args),
     }
+    renders |= {option: _export_render(report, name, args) for option, name in exports.items()}
     extra = [(path, renders[option]) for option, path in outputs.items()]
     # every output is rendered (the yaml, the curves, the page, the table, the figure) before any is written
     written = plan.write(csv=lambda: csv_text(report.table),
                          figure=lambda: report.plot(customary_axis=args.customary_axis), extra=extra)
     progress("done")
+    _export_notes(report, exports, args)
     for warning in report.warnings:
         print(f"warning: {printable(warning)}", file=sys.stderr)
     print_outputs(written, str(report))
+    print_recheck(report, args)
     return 0
+
+
+def axis_and_inflate(args: argparse.Namespace) -> None:
+    """``--axis`` (``--kalibr-axis``, deprecated, warns) and ``--inflate`` checked: ``args.axis``, ``args.inflate``."""
+    old = getattr(args, "kalibr_axis", None)
+    if old is not None:
+        print("warning: --kalibr-axis is deprecated (removed in 0.3.0); use --axis, which every --export "
+              "follows", file=sys.stderr)
+        if args.axis is not None and args.axis != old:
+            raise UsageError(f"--axis {args.axis} and --kalibr-axis {old} disagree; give --axis only")
+    args.axis = args.axis or old or "max"
+    args.kalibr_axis = args.axis
+    if not (args.inflate > 0 and args.inflate < float("inf")):
+        raise UsageError(f"--inflate must be a finite factor > 0 (on densities and random walks), got {args.inflate:g}")
+    args.export = args.export or []
+
+
+def export_outputs(args: argparse.Namespace, inputs: list[Path], outputs: dict) -> dict[str, str]:
+    """Every ``--export NAME[=FILE]`` checked (name, path by the output rules) and added to ``outputs``;
+    returns option -> export name. Two exports to one file are refused (by the caller's check of outputs)."""
+    from avar.fit.report.exports.registry import DEFAULT_FILES, EXPORTS
+
+    exports = {}
+    for text in args.export:
+        name, _, file = text.partition("=")
+        if name not in EXPORTS:
+            raise UsageError(f"--export {printable(text)}: the name must be one of {', '.join(EXPORTS)} "
+                             "(NAME or NAME=FILE)")
+        option = f"--export {text}"
+        if option in outputs:
+            raise UsageError(f"{option} is given twice; give it once")
+        outputs[option] = check_output_path(option, file or DEFAULT_FILES[name], inputs, args.force)
+        exports[option] = name
+    return exports
+
+
+def _export_render(report, name: str, args: argparse.Namespace):
+    from avar.fit.report.exports.registry import export_text
+
+    return lambda: export_text(report, name, axis=args.axis, inflate=args.inflate).encode("utf-8")
+
+
+def _export_notes(report, exports: dict[str, str], args: argparse.Namespace) -> None:
+    """The comments a format cannot hold (Basalt's JSON), on stderr."""
+    from avar.fit.report.exports.registry import export_notes
+
+    for option, name in exports.items():
+        for line in export_notes(report, name, axis=args.axis, inflate=args.inflate):
+            print(f"{printable(option)}: {printable(line)}", file=sys.stderr)
 
 
 def _html(report, args: argparse.Namespace) -> bytes:
@@ -115,7 +184,8 @@ def add_parser(commands) -> None:
         description="The IEEE 952 noise terms of every channel of a log, with no scales to choose: quantization, "
                     "angle/velocity random walk, bias instability, rate random walk, ramp, Gauss-Markov and "
                     "sinusoid terms in SI and customary units with intervals; Kalibr imu.yaml, figure, HTML page.")
-    report.add_argument("file", help=FILE_HELP)
+    report.add_argument("file", nargs="+", help=f"{FILE_HELP}; several logs of one sensor (or a folder of logs) give "
+                        "a report per log, the pooled terms and a test of whether the logs agree")
     report.add_argument("--topic", metavar="TOPIC",
                         help="sensor_msgs/Imu topic of a ROS bag (default: the bag's only Imu topic); "
                              "written as Kalibr's rostopic (default /imu0)")
@@ -127,10 +197,20 @@ def add_parser(commands) -> None:
     add_unit_arguments(report, "or a ROS bag's SI unit")
     add_reading_arguments(report, "from a time column or a ROS bag's stamps; required without them")
     add_confidence_arguments(report, 0.95, "the intervals and of the band", deprecated_alpha=True)
-    report.add_argument("--kalibr", metavar="YAML", help="write a Kalibr imu.yaml (a value for every key; "
-                        "a term the data do not resolve gives its 95%% upper bound, marked in a comment; default: none)")
-    report.add_argument("--kalibr-axis", choices=["max", "mean"], default="max",
-                        help="aggregate the axes of a sensor type for Kalibr: the largest (max, the default) or the mean")
+    report.add_argument("--kalibr", metavar="YAML", help="write a Kalibr imu.yaml, the same as --export kalibr=YAML "
+                        "(a value for every key; a term the data do not resolve gives its one-sided 97.5%% upper "
+                        "bound, marked in a comment; default: none)")
+    report.add_argument("--export", action="append", metavar="NAME[=FILE]",
+                        help="write an estimator's IMU file (repeatable): kalibr (imu.yaml), openvins "
+                             "(kalibr_imu_chain.yaml), vins (vins_imu.yaml), orbslam3 (orbslam3_imu.yaml), basalt "
+                             "(basalt_calib.json), matlab (imu_params.m); FILE defaults to the name in brackets")
+    report.add_argument("--axis", choices=["max", "mean"], default=None,
+                        help="one value per sensor type in every export: the largest over its axes (max, the "
+                             "default) or the mean")
+    report.add_argument("--kalibr-axis", choices=["max", "mean"], default=None, help=argparse.SUPPRESS)
+    report.add_argument("--inflate", type=float, default=1.0, metavar="K",
+                        help="multiply the noise densities and random walks of the exports by K > 0 (a moving "
+                             "platform needs more than static values; the table keeps the measured ones; default: 1)")
     report.add_argument("--curves", metavar="CSV", help="write the curves: Channel, Tau (s), ADEV, Lower, Upper, "
                         "Implied ADEV per level, to redraw any figure (default: none)")
     report.add_argument("--robust", action="store_true", help="robust Allan variance: a log with a few per cent "
@@ -139,6 +219,8 @@ def add_parser(commands) -> None:
                         help="the figure's right axis in deg/h (gyroscopes) or ug (accelerometers) (default: none)")
     report.add_argument("--html", metavar="HTML", help="write the report as one self-contained HTML page "
                         "(inline SVG figures, tables, warnings, command, version; default: none)")
+    add_cluster_arguments(report)
+    add_recheck_arguments(report)
     add_output_arguments(report, "write the table of terms to this CSV file ('-': stdout; default: none, the "
                                  "report is printed)")
     report.set_defaults(handler=run)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable, Iterator, Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -35,25 +35,34 @@ def show_progress(done: int, total: int) -> None:
     sys.stderr.flush()
 
 
+class ReplicateChunk(NamedTuple):
+    """The Allan variances of a chunk of bootstrap replicates (:func:`replicate_allan_variances`)."""
+
+    #: Index of the chunk's first replicate.
+    first: int
+    #: One row per replicate, one column per averaging factor.
+    allan: np.ndarray
+
+
 def replicate_allan_variances(
     model: NoiseModel, n: int, factors: np.ndarray, type: str, replicates: int, rng: np.random.Generator,
     progress: Callable[[int, int], None] | None = None,
-) -> Iterator[tuple[int, np.ndarray]]:
+) -> Iterator[ReplicateChunk]:
     """Allan variances of ``replicates`` series of length ``n`` simulated from ``model``.
 
     The one simulation loop of every parametric bootstrap (AVLR and GMWM):
     replicates are generated in chunks of at most :data:`CHUNK_SAMPLES`
     samples into one reused buffer, and each chunk's Allan variances (type
     ``type`` at the averaging factors ``factors``) come from one parallel
-    kernel call. Yields ``(first replicate index, array (rows, len(factors)))``
-    chunk by chunk; ``progress(done, replicates)`` is called after each.
+    kernel call. Yields a :class:`ReplicateChunk` (first replicate index, array (rows,
+    len(factors))) chunk by chunk; ``progress(done, replicates)`` is called after each.
     """
     chunk = max(1, min(replicates, CHUNK_SAMPLES // n))
     buffer = np.empty((chunk, n))
     for start in range(0, replicates, chunk):
         rows = buffer[: min(chunk, replicates - start)]
         model.simulate_into(rows, rng)
-        yield start, allan_variance_columns(rows.T, factors, type)
+        yield ReplicateChunk(start, allan_variance_columns(rows.T, factors, type))
         if progress is not None:
             progress(start + rows.shape[0], replicates)
 

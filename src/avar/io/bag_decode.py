@@ -26,6 +26,8 @@ a bag message by message.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 #: Bytes from the first float64 (orientation.x) to the end of the message.
@@ -74,7 +76,16 @@ def _fields(buf: np.ndarray, starts: np.ndarray, first: int, big: bool, cdr: boo
     return values, stamps
 
 
-def decode_imu(buf, starts, lengths, cdr: bool) -> tuple[np.ndarray, np.ndarray] | None:
+class ImuMessages(NamedTuple):
+    """The fields avar reads from serialized sensor_msgs/Imu messages (:func:`decode_imu`)."""
+
+    #: (n, 6) float64: angular velocity x, y, z (rad/s), linear acceleration x, y, z (m/s^2).
+    values: np.ndarray
+    #: (n,) int64: header stamps (ns).
+    stamps: np.ndarray
+
+
+def decode_imu(buf, starts, lengths, cdr: bool) -> ImuMessages | None:
     """Gyro and accel (n, 6) float64 and header stamps (n,) int64 ns of serialized Imu messages.
 
     Parameters
@@ -88,15 +99,16 @@ def decode_imu(buf, starts, lengths, cdr: bool) -> tuple[np.ndarray, np.ndarray]
 
     Returns
     -------
-    (values, stamps) or None when the layout cannot be trusted (see the module notes).
+    ImuMessages or None
+        ``values`` and ``stamps``; None when the layout cannot be trusted (see the module notes).
 
     Examples
     --------
     >>> import numpy as np
     >>> body = np.zeros(37, "<f8"); body[13:16] = [0.5, -1.0, 2.0]; body[25:28] = [0.0, 0.0, 9.81]
     >>> msg = np.array([7, 12, 500], "<u4").tobytes() + b"\\x02\\x00\\x00\\x00ab" + body.tobytes()
-    >>> values, stamps = decode_imu(msg, [0], [len(msg)], cdr=False)
-    >>> values.tolist(), stamps.tolist()
+    >>> decoded = decode_imu(msg, [0], [len(msg)], cdr=False)
+    >>> decoded.values.tolist(), decoded.stamps.tolist()
     ([[0.5, -1.0, 2.0, 0.0, 0.0, 9.81]], [12000000500])
     """
     buf = np.frombuffer(buf, np.uint8) if not isinstance(buf, np.ndarray) else buf
@@ -105,7 +117,7 @@ def decode_imu(buf, starts, lengths, cdr: bool) -> tuple[np.ndarray, np.ndarray]
     n = len(starts)
     values, stamps = np.empty((n, 6)), np.empty(n, np.int64)
     if n == 0:
-        return values, stamps
+        return ImuMessages(values, stamps)
     if lengths.min() < 16 + FLOATS or int((starts + lengths).max()) > len(buf) or starts.min() < 0:
         return None
     big = None
@@ -121,8 +133,8 @@ def decode_imu(buf, starts, lengths, cdr: bool) -> tuple[np.ndarray, np.ndarray]
     keys = first * 2 + (big if big is not None else 0)
     groups = np.unique(keys)
     if len(groups) == 1:  # one frame_id length and byte order: no regrouping
-        return _fields(buf, starts, int(groups[0] // 2), bool(groups[0] % 2), cdr)
+        return ImuMessages(*_fields(buf, starts, int(groups[0] // 2), bool(groups[0] % 2), cdr))
     for key in groups:
         rows = np.flatnonzero(keys == key)
         values[rows], stamps[rows] = _fields(buf, starts[rows], int(key // 2), bool(key % 2), cdr)
-    return values, stamps
+    return ImuMessages(values, stamps)

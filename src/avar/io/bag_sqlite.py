@@ -21,6 +21,8 @@ uses plain SQL.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from avar.io.bag_decode import words
@@ -116,14 +118,25 @@ def _leaves(buf: np.ndarray, root: int, page: int) -> np.ndarray:
     raise Untrusted("depth")
 
 
-def read_messages(buf: np.ndarray, root: int, page: int, reserved: int, topics: set[int]):
-    """``(starts, lengths, timestamps)`` of the messages of ``topics`` in rowid order, in ``buf``."""
+class Messages(NamedTuple):
+    """Where the messages of a db3 bag lie in its bytes, in rowid order (:func:`read_messages`)."""
+
+    #: Offset (bytes) of each message in the file.
+    starts: np.ndarray
+    #: Length (bytes) of each message.
+    lengths: np.ndarray
+    #: The bag's receive time of each message (int64 ns).
+    timestamps: np.ndarray
+
+
+def read_messages(buf: np.ndarray, root: int, page: int, reserved: int, topics: set[int]) -> Messages:
+    """The :class:`Messages` of ``topics`` in rowid order, in ``buf``."""
     leaves = _leaves(buf, root, page)
     block = max(1, (4 << 20) // page)  # pages read together: their bytes stay in the CPU's cache
     parts = [_cells(buf, leaves[lo:lo + block], page, reserved, topics) for lo in range(0, len(leaves), block)]
     if not parts:
-        return np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64)
-    return tuple(np.concatenate(column) for column in zip(*parts))
+        return Messages(np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64))
+    return Messages(*(np.concatenate(column) for column in zip(*parts)))
 
 
 def _cells(buf: np.ndarray, leaves: np.ndarray, page: int, reserved: int, topics: set[int]):

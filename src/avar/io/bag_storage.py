@@ -1,8 +1,8 @@
 """The raw bytes of a topic's messages, read in bulk from ROS 1 ``.bag``, ``.db3`` and ``.mcap`` files.
 
-Each reader lists its connections as ``(id, topic, msgtype)`` and yields batches
-``(buf, starts, lengths, receive_ns)``: a uint8 buffer and, for each message, where its
-serialized bytes start, their length and the bag's receive time (ns). Batches come in
+Each reader lists its :class:`Connection` s (``id, topic, msgtype``) and yields
+:class:`Batch` es (``buf, starts, lengths, receive_ns``): a uint8 buffer and, for each message,
+where its serialized bytes start, their length and the bag's receive time (ns). Batches come in
 file order; :func:`avar.io.bags.read_bag` sorts by receive time (stably, as the
 ``rosbags`` readers do). Anything these readers do not understand (an unknown
 compression, an unindexed file, records not where the index says) raises
@@ -25,12 +25,35 @@ import sqlite3
 import struct
 from io import BytesIO
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from avar.io.bag_decode import words
 
 BATCH_BYTES = 32 << 20  # decompressed chunks decoded together
+
+
+class Connection(NamedTuple):
+    """A topic's connection (ROS 1) or channel (ROS 2) in a bag."""
+
+    id: int
+    topic: str
+    msgtype: str
+
+
+class Batch(NamedTuple):
+    """Messages read in bulk: their bytes in ``buf`` and, per message, where they lie and when the
+    bag received it."""
+
+    #: uint8 buffer holding the messages.
+    buf: np.ndarray
+    #: Offset (bytes) of each message's serialized data in ``buf``.
+    starts: np.ndarray
+    #: Length (bytes) of each message's serialized data.
+    lengths: np.ndarray
+    #: The bag's receive time of each message (int64 ns).
+    receive_ns: np.ndarray
 
 
 class Untrusted(Exception):
@@ -76,7 +99,7 @@ class Ros1Bag:
         bio.seek(index_pos)
         self.connections_raw = [reader.read_connection() for _ in range(conn_count)]
         self.chunk_infos = [reader.read_chunk_info() for _ in range(chunk_count)]
-        self.connections = [(c.id, c.topic, c.msgtype) for c in self.connections_raw]
+        self.connections = [Connection(c.id, c.topic, c.msgtype) for c in self.connections_raw]
 
     def close(self) -> None:
         self._reader.bio.close()
@@ -123,7 +146,7 @@ class Ros1Bag:
         if np.any(buf[pos + 4 + at_op] != 2) or np.any(_u32(buf, pos + 4 + at_conn) != conn):
             raise Untrusted("not message records")
         lengths = _u32(buf, pos + 4 + head[0])
-        return buf, pos + 8 + head[0], lengths, times
+        return Batch(buf, pos + 8 + head[0], lengths, times)
 
     def batches(self, ids: set[int]):
         from rosbags.rosbag1.reader import Compression, decompressors
@@ -168,7 +191,7 @@ class McapBag:
         self.path = path
         self._reader = reader = McapReader(path)
         reader.open()
-        self.connections = [(c.id, c.topic, c.msgtype) for c in reader.connections]
+        self.connections = [Connection(c.id, c.topic, c.msgtype) for c in reader.connections]
         if any(ch.message_encoding != "cdr" for ch in reader.channels.values()):
             self.close()
             raise Untrusted("not CDR")
@@ -223,7 +246,7 @@ class McapBag:
         lengths = _u32(buf, start + 1) | (_u32(buf, start + 5) << 32)
         if np.any(buf[start] != 0x05) or np.any(lengths < 22):
             raise Untrusted("not message records")
-        return buf, start + 31, lengths - 22, times
+        return Batch(buf, start + 31, lengths - 22, times)
 
 
 class Db3Bag:
@@ -242,7 +265,7 @@ class Db3Bag:
         if any(row[3] != "cdr" for row in rows):
             self.close()
             raise Untrusted("not CDR")
-        self.connections = [row[:3] for row in rows]
+        self.connections = [Connection(*row[:3]) for row in rows]
 
     def close(self) -> None:
         self._db.close()
@@ -255,8 +278,7 @@ class Db3Bag:
             (page,) = self._db.execute("PRAGMA page_size").fetchone()
             with self.path.open("rb") as bio:
                 buf = _mapped(bio)
-            starts, lengths, times = bag_sqlite.read_messages(buf, root, int(page), int(buf[20]), ids)
-            yield buf, starts, lengths, times
+            yield Batch(buf, *bag_sqlite.read_messages(buf, root, int(page), int(buf[20]), ids))
             return
         except bag_sqlite.Untrusted:
             pass
@@ -270,4 +292,4 @@ class Db3Bag:
         lengths = np.fromiter(map(len, data), np.int64, n)
         starts = np.zeros(n, np.int64)
         np.cumsum(lengths[:-1], out=starts[1:])
-        yield np.frombuffer(b"".join(data), np.uint8), starts, lengths, times
+        yield Batch(np.frombuffer(b"".join(data), np.uint8), starts, lengths, times)

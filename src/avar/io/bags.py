@@ -30,7 +30,7 @@ import numpy as np
 from avar._vocabulary import check_rate, renamed
 from avar.imu import IMU
 from avar.io.bag_decode import decode_imu
-from avar.io.bag_storage import Db3Bag, McapBag, Ros1Bag, Untrusted
+from avar.io.bag_storage import Connection, Db3Bag, McapBag, Ros1Bag, Untrusted
 from avar.io.streams import progress_enabled
 from avar.io.timecols import rate_of
 
@@ -66,15 +66,15 @@ def _files(path: Path) -> list[Path]:
     return [path / name for name in info["relative_file_paths"]]
 
 
-def _choose_topic(connections: list[tuple], path: Path, topic: str | None) -> str:
-    """The Imu topic to read, from ``(id, topic, msgtype)`` tuples."""
-    imu = sorted({c[1] for c in connections if c[2] == IMU_TYPE})
+def _choose_topic(connections: list[Connection], path: Path, topic: str | None) -> str:
+    """The Imu topic to read, from a bag's connections."""
+    imu = sorted({c.topic for c in connections if c.msgtype == IMU_TYPE})
     if topic is None:
         if len(imu) != 1:
             found = f"its Imu topics are {imu}" if imu else "it has none"
             raise BagError(f"{path}: give the sensor_msgs/msg/Imu topic to read (--topic / topic=); {found}")
         topic = imu[0]
-    types = sorted({c[2] for c in connections if c[1] == topic})
+    types = sorted({c.msgtype for c in connections if c.topic == topic})
     if not types:
         raise BagError(f"{path}: no topic {topic!r}; its Imu topics are {imu}")
     if types != [IMU_TYPE]:
@@ -92,7 +92,7 @@ def imu_topics(path: str | Path) -> list[str]:
             return sorted({c.topic for c in reader.connections if c.msgtype == IMU_TYPE})
     for storage in storages:
         storage.close()
-    return sorted({c[1] for s in storages for c in s.connections if c[2] == IMU_TYPE})
+    return sorted({c.topic for s in storages for c in s.connections if c.msgtype == IMU_TYPE})
 
 
 def _bulk(path: Path, topic: str | None, progress: bool):
@@ -108,17 +108,17 @@ def _bulk(path: Path, topic: str | None, progress: bool):
         name = _choose_topic([c for s in storages for c in s.connections], path, topic)
         parts = []
         for storage in storages:
-            ids = {c[0] for c in storage.connections if c[1] == name}
+            ids = {c.id for c in storage.connections if c.topic == name}
             batches = storage.batches(ids) if ids else ()
             if progress:
                 from tqdm import tqdm
 
                 batches = tqdm(batches, desc=f"reading {path.name}", unit="batch", file=sys.stderr, leave=False)
-            for buf, starts, lengths, received in batches:
-                decoded = decode_imu(buf, starts, lengths, cdr=not isinstance(storage, Ros1Bag))
+            for batch in batches:
+                decoded = decode_imu(batch.buf, batch.starts, batch.lengths, cdr=not isinstance(storage, Ros1Bag))
                 if decoded is None:
                     raise Untrusted("layout")
-                parts.append((*decoded, received))
+                parts.append((decoded.values, decoded.stamps, batch.receive_ns))
     finally:
         for storage in storages:
             storage.close()
@@ -134,7 +134,7 @@ def _bulk(path: Path, topic: str | None, progress: bool):
 def _per_message(path: Path, topic: str | None, progress: bool | None):
     """The same, deserializing each message with ``rosbags`` (any layout it knows)."""
     with _reader(path) as reader:
-        name = _choose_topic([(c.id, c.topic, c.msgtype) for c in reader.connections], path, topic)
+        name = _choose_topic([Connection(c.id, c.topic, c.msgtype) for c in reader.connections], path, topic)
         connections = [c for c in reader.connections if c.topic == name]
         total = sum(c.msgcount for c in connections)  # the bag's own count: only for the bar
         messages = reader.messages(connections=connections)

@@ -59,8 +59,9 @@ def check_path(path: Any) -> Path:
 
 
 def _out_of_memory(source: Path) -> InputFileError:
-    limit, meaning = memory_limit()
-    return InputFileError(f"{source}: ran out of memory while reading it (at most {format_bytes(limit)}: {meaning})")
+    limit = memory_limit()
+    return InputFileError(f"{source}: ran out of memory while reading it (at most {format_bytes(limit.size)}: "
+                          f"{limit.meaning})")
 
 
 def _text_columns(path: Path, progress: bool | None) -> tuple[dict[str, Any], Layout]:
@@ -184,7 +185,7 @@ def read(
     -------
     Recording or IMU
         The rate is 1 / the mean time step between gaps (the median step finds the
-        gaps; see :func:`avar._validation.analyze_steps`); ``Recording.rate_note()``
+        gaps; see :func:`avar._time_steps.analyze_steps`); ``Recording.rate_note()``
         says where it came from and the jitter.
 
     Raises

@@ -332,15 +332,23 @@ def _address_space_room() -> int | None:
     return min(rooms) if rooms else None
 
 
-def memory_limit() -> tuple[int, str]:
+class MemoryLimit(NamedTuple):
+    """The bytes a reader may allocate for a file's data, and what that limit is (for messages)."""
+
+    size: int
+    meaning: str
+
+
+def memory_limit() -> MemoryLimit:
     """The bytes a reader may allocate for a file's data, and what that limit is (for messages)."""
     text = os.environ.get(MEMORY_VARIABLE, "").strip()
     if text:
-        return parse_bytes(text), f"the limit set by {MEMORY_VARIABLE}={text}; raise it to read the file"
+        return MemoryLimit(parse_bytes(text), f"the limit set by {MEMORY_VARIABLE}={text}; raise it to read the file")
     known = [room for room in (_available_memory(), _address_space_room()) if room is not None]
     if not known:
-        return sys.maxsize, "no limit"
-    return min(known), f"the memory available to this process; set {MEMORY_VARIABLE} (bytes, e.g. 16G) to try anyway"
+        return MemoryLimit(sys.maxsize, "no limit")
+    return MemoryLimit(min(known), f"the memory available to this process; set {MEMORY_VARIABLE} (bytes, e.g. 16G) "
+                                   "to try anyway")
 
 
 def format_bytes(size: float) -> str:
@@ -357,10 +365,10 @@ def format_bytes(size: float) -> str:
 
 def check_memory(path: Path, needed: int, what: str) -> None:
     """A ValueError naming ``path``, the size and the limit when ``needed`` bytes exceed :func:`memory_limit`."""
-    limit, meaning = memory_limit()
-    if needed > limit:
+    limit = memory_limit()
+    if needed > limit.size:
         raise ValueError(f"{path}: {what} would take {format_bytes(needed)} of memory, more than "
-                         f"{format_bytes(limit)} ({meaning})")
+                         f"{format_bytes(limit.size)} ({limit.meaning})")
 
 
 def progress_enabled(progress: bool | None, values: float) -> bool:

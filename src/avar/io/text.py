@@ -275,8 +275,17 @@ class _Columns:
         return {name: array[:last] for name, array in arrays.items()}
 
 
-def read_columns(path: Path, raw: BinaryIO | None = None) -> tuple[dict[str, np.ndarray], Layout]:
-    """The table's columns as arrays (numbers where they parse, else text), and its layout.
+class Table(NamedTuple):
+    """A text table as read (:func:`read_columns`)."""
+
+    #: Every column by name: numbers where they parse, else text.
+    columns: dict[str, np.ndarray]
+    #: How the file is laid out (separator, decimal mark, header, comment lines ...).
+    layout: Layout
+
+
+def read_columns(path: Path, raw: BinaryIO | None = None) -> Table:
+    """The :class:`Table` of the file's columns as arrays (numbers where they parse, else text), and its layout.
 
     ``raw`` (the opened file, e.g. counted by a progress bar) is parsed instead of ``path`` when
     given. The parser gets the text as UTF-8 from the first line after the comments on (the
@@ -314,7 +323,7 @@ def read_columns(path: Path, raw: BinaryIO | None = None) -> tuple[dict[str, np.
         raise ValueError(f"{path}: not a readable CSV/text table ({message})") from None
     if not columns.arrays:
         raise ValueError(f"{path}: the file holds a header but no data")
-    return columns.finish(), layout
+    return Table(columns.finish(), layout)
 
 
 def _read_chunks(source, layout: Layout, names: list[str], extra: str, columns: _Columns, path: Path) -> None:

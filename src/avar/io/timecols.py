@@ -19,7 +19,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from avar._validation import analyze_steps, describe_gaps
+from avar._time_steps import analyze_steps, describe_gaps
 
 #: Seconds per unit.
 UNIT_SECONDS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
@@ -141,7 +141,7 @@ def to_seconds(values: pd.Series | np.ndarray, name: str, unit: str | None) -> t
 
 
 def rate_of(values, name: str, unit: str | None, gaps: str = "error", what: str = "") -> dict:
-    """Rate, jitter and gaps of a time column (see :func:`avar._validation.analyze_steps`).
+    """Rate, jitter and gaps of a time column (see :func:`avar._time_steps.analyze_steps`).
 
     Returns a dict of :class:`avar.Recording` fields. Gaps raise ValueError (with their
     count and the first row and time) unless ``gaps="ignore"``.
@@ -149,11 +149,12 @@ def rate_of(values, name: str, unit: str | None, gaps: str = "error", what: str 
     steps, elapsed, used = to_seconds(values, name, unit)
     prefix = f"{what}: " if what else ""
     try:
-        rate, median, jitter, gap_positions = analyze_steps(steps)
+        found = analyze_steps(steps)
     except ValueError as error:
         raise ValueError(f"{prefix}time column {name!r}: {error}") from None
+    gap_positions = found.gaps
     if gap_positions.size and gaps != "ignore":
-        message = describe_gaps(gap_positions, steps, median, lambda i: float(elapsed[i]))
+        message = describe_gaps(gap_positions, steps, found.median_step, lambda i: float(elapsed[i]))
         raise ValueError(
             f"{prefix}time column {name!r} has {message}; cut the file at the gaps, or pass gaps='ignore' "
             "(--gaps ignore) to treat the samples as contiguous"
@@ -161,10 +162,10 @@ def rate_of(values, name: str, unit: str | None, gaps: str = "error", what: str 
     source = f"time column {name!r}" + ("" if used in ("s", "date-time") or unit is not None
                                         or time_unit_of(name)[1] else f" (stamps in {used}, by their size)")
     return {
-        "rate": rate,
+        "rate": found.rate,
         "rate_source": source,
         "time_column": name,
-        "jitter": jitter,
+        "jitter": found.jitter,
         "gap_rows": gap_positions + 1,
         "gap_steps": steps[gap_positions],
         "gaps_ignored": bool(gap_positions.size),

@@ -47,12 +47,15 @@ Metrologia 45(5):549-561, 2008.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from avar import _kernels
 from avar.models.arguments import as_whole
+
+if TYPE_CHECKING:
+    from avar._kernels.models.covariance import CovariancePass
 
 __all__ = ["moav", "noav"]
 
@@ -79,20 +82,21 @@ def _as_covmat(covmat: Any) -> np.ndarray:
     return np.ascontiguousarray(c, dtype=np.float64)
 
 
-def _pass(c: np.ndarray, width: int = 0, noav_ns: np.ndarray = _NO_SCALES) -> tuple:
+def _pass(c: np.ndarray, width: int = 0, noav_ns: np.ndarray = _NO_SCALES) -> CovariancePass:
     """Run the one-pass kernel (check + MOAV sums up to ``width`` = 2 max(n) + NOAV
     block sums of ``noav_ns``); raise if covmat is not finite or not symmetric."""
     noav_width = 2 * int(noav_ns.max()) if noav_ns.size else 0
     # many NOAV scales: one prefix scan per row beats per-scale segment sums
     scan = bool(2 * int(noav_ns.sum()) > _kernels.NOAV_SCAN_RATIO * noav_width)
-    asym, top, *sums = _kernels.covariance_pass(c, width, noav_ns, scan, noav_width)
-    amax = float(np.int64(top).view(np.float64))  # max |covmat|, inf/NaN if not finite
+    sums = _kernels.covariance_pass(c, width, noav_ns, scan, noav_width)
+    asym = sums.asym
+    amax = float(np.int64(sums.top).view(np.float64))  # max |covmat|, inf/NaN if not finite
     if not np.isfinite(amax):
         raise ValueError("covmat must be finite (no NaN or inf)")
     if asym > 0 and not asym <= _SYM_RTOL * amax:
         raise ValueError(f"covmat must be symmetric: max |covmat - covmat.T| = {asym:.3g} "
                          f"(tolerance {_SYM_RTOL:g} * max |covmat|)")
-    return tuple(sums)
+    return sums
 
 
 def _check_covmat(covmat: Any) -> np.ndarray:
@@ -206,8 +210,8 @@ def moav(n: Any, covmat: Any) -> float | np.ndarray:
     c, m, ks = _prepare(n, covmat, "moav")
 
     def compute(matrix: np.ndarray) -> np.ndarray:
-        beta, dp, q1, q2, rr, _ = _pass(matrix, width=2 * int(ks[-1]))
-        return _kernels.moav_from_sums(ks, matrix.shape[0], beta, dp, q1, q2, rr)
+        sums = _pass(matrix, width=2 * int(ks[-1]))
+        return _kernels.moav_from_sums(ks, matrix.shape[0], sums.beta, sums.dp, sums.q1, sums.q2, sums.rr)
 
     _check_diagonal(c)
     values = _without_overflow(compute, c)
@@ -257,7 +261,7 @@ def noav(n: Any, covmat: Any) -> float | np.ndarray:
     c, m, ks = _prepare(n, covmat, "noav")
 
     def compute(matrix: np.ndarray) -> np.ndarray:
-        *_, block_sums = _pass(matrix, noav_ns=ks)
+        block_sums = _pass(matrix, noav_ns=ks).noav
         return block_sums / (2.0 * ks * ks * (matrix.shape[0] // (2 * ks)))
 
     _check_diagonal(c)

@@ -11,6 +11,9 @@ methods, :func:`avar.plot_compare` and the command line.
 * :mod:`avar.plotting.deviation`: the deviation family (:func:`plot_deviation`, ``Deviation.plot()``).
 * :mod:`avar.plotting.dynamic`: a dynamic deviation (:func:`plot_dynamic`, ``DynamicDeviation.plot()``).
 * :mod:`avar.plotting.masks`: an MTIE or TDEV under an ITU-T mask (:func:`plot_mask_check`, ``MaskCheck.plot()``).
+
+Every figure draws on the ``ax`` (or ``fig``) given or on a new :class:`matplotlib.figure.Figure`
+not registered with pyplot (headless, no global state), and returns the Figure.
 """
 
 from avar.plotting.compare import plot_compare

@@ -101,14 +101,35 @@ def check_style(deviation: Any, ci: Any, legend_position: Any, markersize: Any,
 
 
 # --------------------------------------------------------------------------- building blocks
-def new_axes(ax: Axes | None) -> tuple[Figure, Axes]:
+class FigureAxes(NamedTuple):
+    """Where a figure function draws: the top-level figure and its axes."""
+
+    fig: Figure
+    ax: Axes
+
+
+class AxisLabels(NamedTuple):
+    """The x and y labels of a figure."""
+
+    xlab: str
+    ylab: str
+
+
+class LogLimits(NamedTuple):
+    """Limits of a log axis, both > 0."""
+
+    low: float
+    high: float
+
+
+def new_axes(ax: Axes | None) -> FigureAxes:
     """The figure of ``ax``, or a new headless figure with one axes."""
     if ax is None:
         fig = Figure(figsize=SINGLE_FIGSIZE, layout="constrained")
-        return fig, fig.add_subplot()
+        return FigureAxes(fig, fig.add_subplot())
     if not isinstance(ax, Axes):
         raise TypeError(f"ax must be a matplotlib Axes or None, got {type(ax).__name__}")
-    return root_figure(ax), ax
+    return FigureAxes(root_figure(ax), ax)
 
 
 def root_figure(artist: Any) -> Figure:
@@ -165,24 +186,29 @@ def band_label(av: AllanVariance, name: str) -> str:
     return f"chi2 CI({name}, {format_confidence(av.confidence)})" if av.ci == "chi2" else f"CI({name}, 0.95)"
 
 
-def axis_labels(units: str | None, deviation: bool, xlab: str | None, ylab: str | None) -> tuple[str, str]:
+def axis_labels(units: str | None, deviation: bool, xlab: str | None, ylab: str | None) -> AxisLabels:
     """Default x and y labels: averaging time (in ``units``) and AV or AD."""
     if xlab is None:
         xlab = r"Averaging time $\tau$" + (f" ({units})" if units else "")
     if ylab is None:
         ylab = r"Allan Deviation $\sigma(\tau)$" if deviation else r"Allan Variance $\sigma^2(\tau)$"
-    return xlab, ylab
+    return AxisLabels(xlab, ylab)
 
 
-def log_limits(*arrays: np.ndarray, pad: float = 0.04) -> tuple[float, float] | None:
-    """Limits spanning the positive finite values, padded by ``pad`` of their decades."""
+def log_limits(*arrays: np.ndarray, pad: float = 0.04) -> LogLimits | None:
+    """:class:`LogLimits` spanning the positive finite values, padded by ``pad`` of their decades;
+    None when there is none.
+
+    >>> log_limits(np.array([1e-3, 10.0, -1.0, np.nan]), pad=0.25)
+    LogLimits(low=0.0001, high=100.0)
+    """
     values = np.concatenate([np.asarray(a, dtype=np.float64).ravel() for a in arrays])
     values = values[np.isfinite(values) & (values > 0)]
     if values.size == 0:
         return None
     low, high = np.log10(values.min()), np.log10(values.max())
     margin = pad * (high - low) if high > low else 0.5
-    return 10 ** (low - margin), 10 ** (high + margin)
+    return LogLimits(float(10 ** (low - margin)), float(10 ** (high + margin)))
 
 
 def setup_log_axes(ax: Axes) -> None:
@@ -261,7 +287,7 @@ def implied_curve(implied_ad: Any, decomposition: Mapping[str, Any], implied: st
 
 
 def finish(ax: Axes, xlab: str, ylab: str, main: str | None, legend: str | None,
-           limits: tuple[float, float] | None) -> None:
+           limits: LogLimits | None) -> None:
     """Labels, title, y limits and legend."""
     ax.set_xlabel(xlab)
     ax.set_ylabel(ylab)

@@ -36,6 +36,7 @@ def plot_deviation(
     legend_position: str | None = "lower left",
     marker: str = "o",
     ax: Axes | None = None,
+    mask: Any = None,
 ) -> Figure:
     """Log-log plot of a deviation against tau with its chi-squared error bars.
 
@@ -60,6 +61,11 @@ def plot_deviation(
         Matplotlib marker of the points.
     ax : matplotlib.axes.Axes, optional
         Axes to draw on; by default a new Figure.
+    mask : str or Mask, optional
+        An ITU-T mask drawn as a dashed line over the MTIE or TDEV: a name of
+        :data:`avar.MASKS`, a clock's name (``"G.8262 EEC option 1"``: its mask of
+        this statistic) or a :class:`avar.Mask`; see :func:`avar.mask_check` for the
+        verdict.
 
     Returns
     -------
@@ -73,6 +79,10 @@ def plot_deviation(
     >>> ax = plot_deviation(res).axes[0]
     >>> ax.get_xscale(), ax.get_yscale(), ax.get_ylabel()
     ('log', 'log', 'OADEV $\\\\sigma_y(\\\\tau)$')
+    >>> tdev = avar.tdev(np.random.default_rng(1).standard_normal(1000) * 1e-9, data_type="phase")
+    >>> line = tdev.plot(mask="G.8262 EEC option 1").axes[0].lines[-1]
+    >>> line.get_label(), line.get_xdata().tolist()
+    ('G.8262 EEC option 1 TDEV', [0.1, 25.0, 25.0, 100.0, 100.0, 1000.0])
     """
     if not isinstance(x, Deviation):
         raise TypeError(f"x must be a Deviation (from avar.adev, avar.oadev, ...), got {type(x).__name__}")
@@ -100,6 +110,15 @@ def plot_deviation(
                         ecolor=colour, elinewidth=1.0, capsize=3, zorder=2,
                         label=f"{format_confidence(x.confidence)} confidence (chi-squared)")
             drawn += [x.lci[valid], x.uci[valid]]
+    if mask is not None:
+        from avar.plotting.masks import draw_mask, mask_line
+        from avar.stability.time_error.masks import find_mask
+
+        found = find_mask(mask, x.estimator)
+        top = max(float(np.max(x.taus)), 10 * found.pieces[-1].low)
+        draw_mask(ax, found, top)
+        taus, limits = mask_line(found, top)
+        drawn.append(limits[(taus >= np.min(x.taus)) & (taus <= np.max(x.taus))])
     if ylab is None:
         ylab = f"{x.name} $\\sigma_x(\\tau)$ (s)" if x.estimator in ("tdev", "ttotdev") else f"{x.name} $\\sigma_y(\\tau)$"
     xlab = r"Averaging time $\tau$ (s)" if xlab is None else xlab

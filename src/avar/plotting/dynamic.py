@@ -1,9 +1,5 @@
-"""The figure of a dynamic deviation (``DynamicDeviation.plot()``): a heat map or Stable32's 3-D view.
-
-Like every figure of :mod:`avar.plotting`, it draws on the ``ax`` given or on a new
-:class:`matplotlib.figure.Figure` not registered with pyplot (headless, no global state), and
-returns the Figure.
-"""
+"""The figure of a dynamic deviation (``DynamicDeviation.plot()``): a heat map or Stable32's 3-D view,
+drawn and returned as every figure of :mod:`avar.plotting`."""
 
 from __future__ import annotations
 

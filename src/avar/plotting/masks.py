@@ -1,7 +1,8 @@
 """The figure of an ITU-T mask check (``MaskCheck.plot()``): the measured MTIE or TDEV and the mask.
 
 Drawn on the ``ax`` given or on a new headless figure, as every figure of :mod:`avar.plotting`.
-The mask's name goes into the legend as plain text (no mathtext).
+The mask's name goes into the legend as plain text (no mathtext). :func:`draw_mask` draws a
+mask's line on any axes (also ``Deviation.plot(mask=...)``).
 """
 
 from __future__ import annotations
@@ -11,17 +12,40 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from avar.plotting.base import AD_COLOUR, new_axes, setup_log_axes
-from avar.stability.time_error.masks import MaskCheck
+from avar.stability.time_error.masks import Mask, MaskCheck
+
+#: Points of a piece whose limit is a sum of power laws (a curve on log-log axes).
+CURVE_POINTS = 60
+
+
+def mask_line(mask: Mask, top: float) -> tuple[np.ndarray, np.ndarray]:
+    """The (tau, limit) points of ``mask``'s line (s, s): each piece from its low end to its high end
+    (``top`` for an open end). A piece of one power law is straight on log-log axes: its two ends;
+    a sum of power laws: :data:`CURVE_POINTS` points. A piece's ends are the mask's breakpoints."""
+    taus: list[np.ndarray] = []
+    limits: list[np.ndarray] = []
+    for piece in mask.pieces:
+        high = top if np.isinf(piece.high) else piece.high
+        if high <= piece.low:
+            continue
+        grid = (np.array([piece.low, high]) if len(piece.powers) == 1
+                else np.geomspace(piece.low, high, CURVE_POINTS))
+        taus.append(grid)
+        limits.append(piece.limit(grid))
+    return np.concatenate(taus), np.concatenate(limits)
+
+
+def draw_mask(ax: Axes, mask: Mask, top: float, colour="0.3") -> None:
+    """The mask's limit as a dashed line on ``ax``, labelled with its name (plain text)."""
+    taus, limits = mask_line(mask, top)
+    ax.plot(taus, limits, color=colour, linestyle="--", label=mask.name.replace("$", r"\$"), zorder=1)
 
 
 def plot_mask_check(check: MaskCheck, ax: Axes | None = None) -> Figure:
     """Log-log plot of the measured curve (points failing the mask in red) under the mask's limit."""
     fig, ax = new_axes(ax)
     setup_log_axes(ax)
-    low, high = check.mask.taus
-    top = check.taus.max() if np.isinf(high) else high
-    grid = np.geomspace(low * (1 + 1e-9), top, 400)
-    ax.plot(grid, check.mask.limit(grid), color="0.3", linestyle="--", label=check.mask.name.replace("$", r"\$"))
+    draw_mask(ax, check.mask, max(float(check.taus.max()), 10 * check.mask.pieces[-1].low))
     ax.plot(check.taus, check.measured, "o-", color=AD_COLOUR, markersize=4, label="measured")
     failing = ~check.passes
     if failing.any():

@@ -9,7 +9,10 @@ against tau in seconds, with the data unit on the y axis:
 * one dashed line per term present, labelled with its value and unit
   (customary units for gyroscopes and accelerometers: deg/sqrt(h), deg/h,
   deg/h/sqrt(h); m/s/sqrt(h), ug, m/s^2/sqrt(h));
-* Gauss-Markov and sinusoid terms, labelled by correlation time and frequency;
+* Gauss-Markov and sinusoid terms, labelled by correlation time and frequency; those
+  that model the sensor's own filtering or vibration (the table's ``Group`` "sensor
+  filtering", :func:`avar.fit.report.rows.group_of`) in a legend section of their own,
+  "sensor filtering:", after the IEEE 952 terms and the implied curve;
 * the Allan-deviation minimum (a star, labelled in deg/h or ug): the
   datasheets' in-run bias stability; the B line says its convention;
 * a panel whose fit fails the check says so in its title;
@@ -45,6 +48,8 @@ __all__ = ["plot_report", "term_label"]
 COLOURS = {**PROCESS_COLOURS, "FN": "#1F77B4", "AR1": "#8C564B", "SIN": "#E377C2"}
 SYMBOLS = {"QN": "Q", "WN": "N", "FN": "B", "RW": "K", "DR": "R"}
 BI_MARKER = "*"
+#: The legend section of the terms of the sensor's own filtering or vibration (the table's ``Group``).
+FILTERING = "sensor filtering"
 PANEL_SIZE = (4.6, 3.6)
 
 
@@ -166,6 +171,23 @@ def _component_label(report: Any, channel: str, kind: str, number: int) -> str:
     return f"Sinusoid {number}: {1.0 / float(row['Tau (s)']):.3g} Hz"
 
 
+def _group(report: Any, channel: str, kind: str, number: int) -> str:
+    """The table's ``Group`` of a term (``IEEE 952`` when the table has none)."""
+    if "Group" not in report.terms.columns:
+        return "IEEE 952"
+    process = kind if kind in SYMBOLS else f"{kind}_{number}"
+    rows = report.terms[(report.terms["Channel"] == channel) & (report.terms["Process"] == process)]
+    group = rows["Group"].iloc[0] if len(rows) else None
+    return group if isinstance(group, str) and group else "IEEE 952"
+
+
+def _draw_component(ax: Any, report: Any, channel: str, av: Any, component: Any, number: int, power: int,
+                    linestyle: str = "--") -> None:
+    variance = component.av(av.averaging_factors)
+    ax.plot(av.levels, np.sqrt(variance) ** power, color=COLOURS.get(component.kind, "0.3"), linestyle=linestyle,
+            linewidth=1.2, label=_component_label(report, channel, component.kind, number), zorder=2)
+
+
 def _panel(ax: Any, report: Any, channel: str, deviation: bool, power: int, implied: str, ci: bool,
            legend: bool) -> None:
     av, fit = report.avs[channel], report.fits[channel]
@@ -176,18 +198,19 @@ def _panel(ax: Any, report: Any, channel: str, deviation: bool, power: int, impl
                            marker="o", markersize=3.5, label="Empirical AD" if deviation else "Empirical AV",
                            band_label=None)
     counts: dict[str, int] = {}
+    filtering = []
     for component in fit.components:
         counts[component.kind] = counts.get(component.kind, 0) + 1
-        variance = component.av(av.averaging_factors)
-        ax.plot(av.levels, np.sqrt(variance) ** power, color=COLOURS.get(component.kind, "0.3"), linestyle="--",
-                linewidth=1.2, label=_component_label(report, channel, component.kind, counts[component.kind]),
-                zorder=2)
+        if _group(report, channel, component.kind, counts[component.kind]) == FILTERING:
+            filtering.append((component, counts[component.kind]))
+            continue
+        _draw_component(ax, report, channel, av, component, counts[component.kind], power)
     extra = []
     rows = report.terms[(report.terms["Channel"] == channel) & (report.terms["Process"] == "MIN")]
     if len(rows):
         row = rows.iloc[0]
         tau_min = float(row["Tau (s)"])
-        level = float(np.min(av.adev)) ** power
+        level = float(np.asarray(av.adev)[int(np.argmin(np.abs(np.log(np.asarray(av.levels) / tau_min))))]) ** power
         text = f"{float(row['Customary']):.3g} {row['Customary unit']}" if row["Customary unit"] else f"{level:.3g}"
         ax.plot([tau_min], [level], linestyle="none", marker=BI_MARKER, markersize=13, color=COLOURS["FN"],
                 markeredgecolor="black", label=f"AD minimum {text} at {tau_min:.3g} s", zorder=6)
@@ -197,6 +220,10 @@ def _panel(ax: Any, report: Any, channel: str, deviation: bool, power: int, impl
     label = "Implied AD" if deviation else "Implied AV"
     label += " (sum of variances)" if implied == "sum" else " (R: square of summed deviations)"
     ax.plot(av.levels, curve, color=IMPLIED_COLOUR, linewidth=2.0, label=label, zorder=4)
+    if filtering:  # a legend section of its own: a header without a line, then its terms
+        ax.plot([], [], linestyle="none", label=f"{FILTERING}:")
+        for component, number in filtering:
+            _draw_component(ax, report, channel, av, component, number, power, linestyle=":")
     limits = log_limits(*drawn, curve, *extra, pad=0.08)
     if limits is not None:
         ax.set_ylim(*limits)

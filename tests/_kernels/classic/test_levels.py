@@ -172,3 +172,18 @@ def test_centred_moment_equals_a_plain_loop_at_any_thread_count():
         numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
         assert bits[0] == bits[1]
         assert bits[0] == pytest.approx(expected, rel=1e-10)
+
+
+@pytest.mark.parametrize("estimator", ["oadev", "mdev", "mhdev", "ohdev", "totdev"])
+def test_a_huge_phase_ramp_keeps_the_digits_of_the_noise(estimator):
+    """x = 1e3 i + 1e-9 noise: the first increment's rounding (x[1] - x[0]) is a constant low part
+    of every increment, which MDEV's running sum of the phase adds up linearly; its float32 low
+    part kept 24 bits of that line rather than of the sum (MDEV off by 1.7e-10 relative)."""
+    x = 1e3 * np.arange(2000.0) + 1e-9 * np.random.default_rng(0).standard_normal(2000)
+    factors = np.array([1, 2, 4, 16, 64])
+    from avar._kernels.runtime.paths import forced
+
+    with forced("compiled"):
+        variance, _ = deviation_levels(estimator, x, factors, "phase", 1.0)
+    for m, v in zip(factors, variance):
+        assert v == pytest.approx(exact_variance(estimator, x, int(m), "phase")[0], rel=1e-13), m

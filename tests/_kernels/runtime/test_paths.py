@@ -37,6 +37,17 @@ def test_compiled_kernels_and_large_records_take_the_kernels(monkeypatch):
 def test_a_hot_dispatch_compiles_after_all(monkeypatch):
     monkeypatch.setattr(paths, "ENVIRONMENT_MODE", None)
     monkeypatch.setattr(paths, "HOT_WORK", 1000)
+    monkeypatch.setattr(paths, "CALL_WORK", 0)
     kernel = njit(lambda x: x)
     taken = [paths.numpy_path(300, 10_000, (kernel,)) for _ in range(5)]
     assert taken == [True, True, True, False, False]  # 900 units spent in the twin, then the kernels
+
+
+def test_many_small_calls_turn_hot_too(monkeypatch):
+    # each call is charged its twin's fixed cost: 100 units of work + 150 per call
+    monkeypatch.setattr(paths, "ENVIRONMENT_MODE", None)
+    monkeypatch.setattr(paths, "HOT_WORK", 1000)
+    monkeypatch.setattr(paths, "CALL_WORK", 150)
+    kernel = njit(lambda x: x)
+    taken = [paths.numpy_path(100, 10_000, (kernel,)) for _ in range(6)]
+    assert taken == [True, True, True, True, False, False]  # 4 x 250 = 1000 spent

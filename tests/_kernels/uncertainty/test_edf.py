@@ -71,7 +71,7 @@ def test_basic_sums_equal_the_numpy_twin(d, modified):
 
 @pytest.mark.parametrize("d", [1, 2, 3])
 def test_greenhall_sums_in_numpy_equal_the_compiled_ones(d):
-    """Few rows take NumPy's sums, many the compiled loops: the same values either way."""
+    """NumPy's sums (a cold process) and the compiled loops: the same values either way."""
     from avar._kernels.runtime.paths import forced
     from avar._kernels.uncertainty.edf import NUMPY_ROWS, greenhall_sums
 
@@ -86,7 +86,31 @@ def test_greenhall_sums_in_numpy_equal_the_compiled_ones(d):
     args = (j, big_m, m.copy(), f, alpha, d, norm, big_m.copy())
     compiled = np.empty(rows)
     basic_sums(*args, compiled)
-    np.testing.assert_allclose(greenhall_sums(*args), compiled, rtol=1e-9)
+    with forced("numpy"):
+        np.testing.assert_allclose(greenhall_sums(*args), compiled, rtol=1e-9)
     many = [np.concatenate([a, a]) if isinstance(a, np.ndarray) else a for a in args]
     with forced("compiled"):  # (a cold process, or AVAR_KERNEL_PATH=numpy, would take NumPy's sums for these too)
         np.testing.assert_array_equal(greenhall_sums(*many), np.concatenate([compiled, compiled]))
+
+
+@pytest.mark.parametrize("alpha", [2, 1, 0, -1, -2])
+@pytest.mark.parametrize("f_kind", ["finite", "infinite"])
+def test_greenhall_sums_of_one_noise_type_equal_the_compiled_ones(alpha, f_kind):
+    """One noise exponent for every row (a long record's octave levels): NumPy computes only its power."""
+    from avar._kernels.runtime.paths import forced
+    from avar._kernels.uncertainty.edf import greenhall_sums
+
+    d = 2
+    m = 2.0 ** np.arange(12)
+    j = np.minimum(m * (d + 1), 100.0)
+    big_m = j + 7.0
+    f = m.copy() if f_kind == "finite" else np.full(12, np.inf)
+    args = (j, big_m, m.copy(), f, np.full(12, alpha), d, np.full(12, np.nan), big_m.copy())
+    compiled = np.empty(12)
+    basic_sums(*args, compiled)
+    expected = plain_basic_sum(j, big_m, m, f, np.full(12, alpha), d) / (
+        plain_sz(np.zeros(12), f, np.full(12, alpha), d) ** 2 * big_m)
+    for path in ("numpy", "compiled"):
+        with forced(path):
+            np.testing.assert_allclose(greenhall_sums(*args), compiled, rtol=1e-9)
+            np.testing.assert_allclose(greenhall_sums(*args), expected, rtol=1e-9)

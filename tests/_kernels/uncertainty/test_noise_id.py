@@ -107,3 +107,64 @@ def test_moments_with_drift_equal_the_moments_of_the_drifted_points(count, m, dr
     want = plain_moments(z + drift * i * (i - 1.0) / 2.0)
     got = moments_with_drift(plain_moments(z), drift, m)
     np.testing.assert_allclose(got, want, rtol=1e-11, atol=1e-11 * np.abs(want).max())
+
+
+def exact_alpha(x: np.ndarray, m: int, dmax: int) -> float:
+    """The lag-1 rule (line removed, Stable32's r1) on x[::m] in exact rational arithmetic."""
+    from fractions import Fraction
+
+    z = [Fraction(float(v)) for v in x[::m]]
+    k = len(z)
+    t = [Fraction(2 * j - (k - 1), 2) for j in range(k)]
+    mean = sum(z) / k
+    slope = sum(a * b for a, b in zip(t, z)) / Fraction(k * (k * k - 1), 12)
+    w = [a - (mean + slope * b) for a, b in zip(z, t)]
+    for d in range(dmax + 1):
+        if d:
+            w = [w[j + 1] - w[j] for j in range(len(w) - 1)]
+        c = sum(w) / len(w)
+        centred = [v - c for v in w]
+        power = sum(v * v for v in centred)
+        r1 = sum(a * b for a, b in zip(centred[:-1], centred[1:])) / power * Fraction(len(w) - 1, len(w))
+        rho = r1 / (1 + r1)
+        if rho < Fraction(1, 4) or d >= dmax:
+            return float(2 - round(2 * rho) - 2 * d)
+    return np.nan
+
+
+def test_a_dominant_frequency_drift_keeps_the_noise_digits():
+    # x = 1e-2 i^2 + 1e-6 random walk: the second differences are the drift's constant 0.02 m^2
+    # (1e3 at m = 256) plus 1e-5 of noise; summing their squares before removing their mean
+    # lost every digit (alpha -8 at m = 256, -2 at m = 512); now as exact arithmetic
+    n = 20_000
+    i = np.arange(n, dtype=np.float64)
+    x = 1e-2 * i * i + 1e-6 * np.cumsum(np.random.default_rng(1).standard_normal(n))
+    for m in (64, 128, 256, 512):
+        expected = exact_alpha(x, m, 2)
+        assert lag1_alpha_decimated(x, m, 2, np.nan) == expected, m
+        assert plain_alpha(x, m, 2) == expected, m
+    assert exact_alpha(x, 256, 2) == -1.0  # not a test that cannot fail: the levels differ
+    assert exact_alpha(x, 512, 2) == 0.0
+
+
+@pytest.mark.parametrize("estimator", ["adev", "hdev", "oadev"])
+def test_a_dominant_drift_in_frequency_data_is_identified_as_exactly(estimator):
+    # ADEV and HDEV of octave frequency data decide from the pyramid's one-pass moments: the
+    # variance about a mean far above the noise lost every digit there (HDEV read white PM at
+    # m = 256); such a level now goes to the two-pass kernel, which agrees with the NumPy twin
+    # and, at m = 128 .. 512, with exact arithmetic on the phase
+    import avar
+    from avar._kernels.runtime.paths import forced
+
+    n = 20_000
+    i = np.arange(n, dtype=np.float64)
+    x = 1e-2 * i * i + 1e-6 * np.cumsum(np.random.default_rng(1).standard_normal(n))
+    found = {}
+    for path in ("numpy", "compiled"):
+        with forced(path):
+            result = getattr(avar, estimator)(np.diff(x), data_type="freq")
+        found[path] = result.alpha
+    np.testing.assert_array_equal(found["compiled"], found["numpy"])
+    levels = list(result.averaging_factors)
+    for m in (128, 256, 512):
+        assert found["compiled"][levels.index(m)] == exact_alpha(x, m, 3 if "h" in estimator else 2), m

@@ -148,7 +148,8 @@ def phase_increment(data, data_lo, i, kind, centre, slope, scale):
 @njit(cache=True, nogil=True)
 def _phase_block(data, data_lo, kind, centre, slope, scale, b, block, start_hi, start_lo, hi, lo, write):
     """Compensated sum of the increments of block ``b`` from ``start_hi + start_lo``; with
-    ``write``, the running sums are written to ``hi, lo``."""
+    ``write``, the running sums are written to ``hi, lo`` (``kind`` 2: as a renormalized pair,
+    ``lo`` within half an ulp of ``hi``)."""
     n = hi.shape[0] - 1
     total = start_hi
     comp = start_lo
@@ -157,8 +158,12 @@ def _phase_block(data, data_lo, kind, centre, slope, scale, b, block, start_hi, 
         total, err = two_sum(total, h)
         comp += err + l
         if write:
-            hi[i + 1] = total
-            lo[i + 1] = comp
+            if kind == 2:  # renormalized: the increments' low parts (the phase's) add up in ``comp``,
+                # a constant one linearly, and float32 ``lo`` would keep 24 bits of that, not of the sum
+                hi[i + 1], lo[i + 1] = two_sum(total, comp)
+            else:
+                hi[i + 1] = total
+                lo[i + 1] = comp
     return total, comp
 
 

@@ -31,6 +31,8 @@ row by row (each row of a block is two or three segment sums).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
@@ -261,7 +263,24 @@ def _cov_task(task, c, beta, width, noav_ns, noav_scan, tile, split, far, asym, 
     top[task] = run_top
 
 
-def covariance_pass(c, width, noav_ns, noav_scan, noav_width, tile=COV_TILE):
+class CovariancePass(NamedTuple):
+    """What :func:`covariance_pass` finds: the checks of ``c`` and the MOAV / NOAV sums."""
+
+    #: max |c - c.T| (meaningless if c is not finite).
+    asym: float
+    #: Bits of max |c| (as float64): >= 0x7FF0000000000000 iff c holds an infinite or NaN entry.
+    top: int
+    #: Diagonal centres, centred diagonal sums and corner sums, shape (width,) each (see above).
+    beta: np.ndarray
+    dp: np.ndarray
+    q1: np.ndarray
+    q2: np.ndarray
+    rr: np.ndarray
+    #: Sum over the disjoint blocks of ``w' C_s w``, one per NOAV scale.
+    noav: np.ndarray
+
+
+def covariance_pass(c, width, noav_ns, noav_scan, noav_width, tile=COV_TILE) -> CovariancePass:
     """Check ``c`` and gather the MOAV / NOAV sums, in one pass of two tasks on the threads.
 
     Parameters
@@ -279,15 +298,12 @@ def covariance_pass(c, width, noav_ns, noav_scan, noav_width, tile=COV_TILE):
 
     Returns
     -------
-    asym : float
-        max |c - c.T| (meaningless if c is not finite).
-    top : int64
-        Bits of max |c| (as float64): >= 0x7FF0000000000000 iff c holds an
-        infinite or NaN entry.
-    beta, dp, q1, q2, rr : float64 arrays, shape (width,)
-        Diagonal centres, centred diagonal sums and corner sums (see above).
-    noav : float64 array, shape (len(noav_ns),)
-        Sum over the disjoint blocks of ``w' C_s w``.
+    CovariancePass
+        ``asym`` (float): max |c - c.T| (meaningless if c is not finite); ``top`` (int): bits
+        of max |c| (as float64), >= 0x7FF0000000000000 iff c holds an infinite or NaN entry;
+        ``beta, dp, q1, q2, rr`` (float64 arrays, shape (width,)): diagonal centres, centred
+        diagonal sums and corner sums (see above); ``noav`` (float64 array, shape
+        (len(noav_ns),)): sum over the disjoint blocks of ``w' C_s w``.
 
     Notes
     -----
@@ -316,7 +332,8 @@ def covariance_pass(c, width, noav_ns, noav_scan, noav_width, tile=COV_TILE):
     noav = acc[0, :n] + acc[1, :n]
     with np.errstate(over="ignore", invalid="ignore"):  # as in compiled code: an overflow is inf, caught later
         out = sums[0][[0, 3, 4, 5], :width] + sums[1][[0, 3, 4, 5], :width]
-    return float(max(asym[0], asym[1])), int(max(top[0], top[1])), beta, out[0], out[1], out[2], out[3], noav
+    return CovariancePass(float(max(asym[0], asym[1])), int(max(top[0], top[1])), beta, out[0], out[1], out[2], out[3],
+                          noav)
 
 
 @njit(cache=True)

@@ -9,7 +9,7 @@ samples or terms, within the twin's ``limit``) and the kernels it would run are 
 compiled yet, neither in this process nor in numba's cache for this machine
 (:func:`compiled`). Once they are (``avar warmup``, a long record, an earlier run), the
 kernels run, as fast as before. A process that keeps calling turns hot: once a dispatch
-has spent :data:`HOT_WORK` units in its twin (about a second), it compiles its kernels
+has spent :data:`HOT_WORK` units in its twin (under a second lost), it compiles its kernels
 after all, and is fast from then on (and so are later processes, from numba's cache).
 The two paths agree to about 1e-15 (the tests ask 1e-12): the last bits of a result may
 differ between a cold and a warm run, as they do between CPUs.
@@ -34,7 +34,7 @@ import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-__all__ = ["ENVIRONMENT", "ENVIRONMENT_MODE", "FORCED", "PATHS", "compiled", "forced", "numpy_path", "path_mode"]
+__all__ = ["CALL_WORK", "ENVIRONMENT", "ENVIRONMENT_MODE", "FORCED", "PATHS", "compiled", "forced", "numpy_path", "path_mode"]
 
 #: The environment variable that forces a path.
 ENVIRONMENT = "AVAR_KERNEL_PATH"
@@ -60,8 +60,14 @@ def path_mode() -> str:
 
 
 #: Work (samples, terms) a dispatch may spend in its NumPy twin in one process before it compiles
-#: its kernels after all: about a second of NumPy, against seconds of compilation once.
-HOT_WORK = 1 << 27
+#: its kernels after all (ski rental: about as much time lost to the twin as compiling costs once).
+#: Measured (issue 39): the twins lose about 25 ms per 1e6 samples to the kernels (OADEV's noise
+#: identification and scan) and 0.4 ms per call of 1e4 (``avar()``), so 2**25 units plus
+#: :data:`CALL_WORK` per call lose 0.5 to 1 s, against 1 to 3 s of compilation.
+HOT_WORK = 1 << 25
+#: Work charged per dispatch on top of its size: a twin's fixed cost per call (NumPy's per-operation
+#: overhead, a few hundred microseconds) in samples, so that many small calls turn hot too.
+CALL_WORK = 1 << 13
 #: (kernel, first argument's type) pairs known compiled, and those numba's cache lacked at the first look.
 _COMPILED: set[tuple] = set()
 _NOT_CACHED: set[tuple] = set()
@@ -121,7 +127,8 @@ def numpy_path(work: int | Callable[[], int], limit: int, kernels: tuple | Calla
     """Whether a call of ``work`` units (samples, terms) takes the NumPy twin: forced, or its
     work is within ``limit`` (and ``fits``, the caller's other size limits, holds),
     ``kernels`` are not :func:`compiled` yet (for ``argument``) and the twins standing in
-    for them have spent less than :data:`HOT_WORK` in this process. ``work`` and ``kernels``
+    for them have spent less than :data:`HOT_WORK` in this process (each call its work plus
+    :data:`CALL_WORK`). ``work`` and ``kernels``
     may be callables, evaluated only when needed; ``route``, a hashable that determines
     ``kernels`` and their argument types, skips even that once they were found compiled.
 
@@ -148,7 +155,7 @@ def numpy_path(work: int | Callable[[], int], limit: int, kernels: tuple | Calla
     if work > limit:
         return False
     key = tuple(id(entry[0] if isinstance(entry, tuple) else entry) for entry in kernels)
-    spent = _SPENT.get(key, 0) + work
+    spent = _SPENT.get(key, 0) + work + CALL_WORK
     if spent > HOT_WORK:
         return False  # hot: compile now, and be fast from here on
     _SPENT[key] = spent

@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit
 
 from avar._kernels.runtime.tasks import run_ranges
+from avar._kernels.total.windows import LevelSum, LevelSums
 
 #: Windows per task: fixed, so the sums do not depend on the number of threads.
 CHUNK = 256
@@ -80,7 +81,7 @@ def _task_range(x, m, bad, shift, n_windows, first_task, stop_task, sums, counts
         counts[task - first_task] = used
 
 
-def level_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> tuple[float, int]:
+def level_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> LevelSum:
     """Sum of the terms T(n) of the windows of level ``m`` that avoid the gaps, and their number."""
     n_windows = max(0, x.shape[0] - 4 * int(m) + 1)
     n_tasks = (n_windows + CHUNK - 1) // CHUNK
@@ -95,13 +96,13 @@ def level_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> tuple[float
     total = 0.0
     for part in sums.tolist():  # in task order
         total += part
-    return total, int(counts.sum())
+    return LevelSum(total, int(counts.sum()))
 
 
-def level_sums(x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int) -> tuple[np.ndarray, np.ndarray]:
+def level_sums(x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int) -> LevelSums:
     """:func:`level_sum` at every factor: the sums and the windows used."""
     sums = np.zeros(factors.shape[0])
     counts = np.zeros(factors.shape[0], dtype=np.int64)
     for level, m in enumerate(factors.tolist()):
         sums[level], counts[level] = level_sum(x, m, bad, shift)
-    return sums, counts
+    return LevelSums(sums, counts)

@@ -36,8 +36,29 @@ local wander, not eps |x|; X and G sum terms of the size of S.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
+
+
+class ExpandedSums(NamedTuple):
+    """Double sums computed by an expansion, and each one's ratio of the expansion's largest terms
+    to it: the sum has about ``eps * ratio`` relative error (inf where the sum is not > 0)."""
+
+    sums: np.ndarray
+    ratios: np.ndarray
+
+
+class SplitParts(NamedTuple):
+    """What the levels m <= K of one knot spacing K share (:func:`split_parts`)."""
+
+    #: r = x less its broken line (:func:`split_record`).
+    rest: np.ndarray
+    #: P(v) = sum_k beta_k r_{t_k + v}, v = -(K - 1) .. K - 1 (:func:`knot_profile`).
+    profile: np.ndarray
+    #: sum_k beta_k^2.
+    kink_square: float
 
 
 @njit(cache=True)
@@ -154,31 +175,39 @@ def crossing_terms(profile: np.ndarray, reach: int, kink_square: float, factors:
     return cross, square, magnitude
 
 
-def split_parts(x: np.ndarray, spacing: int) -> tuple[np.ndarray, np.ndarray, float]:
+def split_parts(x: np.ndarray, spacing: int) -> SplitParts:
     """r of :func:`split_record` at knot spacing K = ``spacing``, the profile P (reach K) and
     sum_k beta_k^2: all that the levels m <= K share."""
     r, knots, kinks = split_record(x, int(spacing))
-    return r, knot_profile(r, knots, kinks, int(spacing)), float(kinks @ kinks)
+    return SplitParts(r, knot_profile(r, knots, kinks, int(spacing)), float(kinks @ kinks))
 
 
-def combine(rest: np.ndarray, rest_ratio: np.ndarray, parts: tuple, spacing: int, factors: np.ndarray,
-            allan: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def combine(rest: np.ndarray, rest_ratio: np.ndarray, parts: SplitParts, spacing: int, factors: np.ndarray,
+            allan: bool = False) -> ExpandedSums:
     """S(x) = S(r) + 2 X + G at ``factors`` (each <= ``spacing``) from S(r) (``rest``) and its ratio,
     and the ratio of the largest terms to S(x): ratio(r) S(r) + 2 |X's terms| + G, over S(x).
     ``allan``: the overlapping Allan sums at ``factors`` / 2 instead (:func:`crossing_terms`)."""
-    _, profile, kink_square = parts
-    cross, square, magnitude = crossing_terms(profile, int(spacing), kink_square,
+    cross, square, magnitude = crossing_terms(parts.profile, int(spacing), parts.kink_square,
                                               np.ascontiguousarray(factors, dtype=np.int64), bool(allan))
     total = rest + 2.0 * cross + square
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         terms = rest_ratio * np.abs(rest) + 2.0 * magnitude + square
         ratio = np.where((total > 0) & np.isfinite(terms), terms / total, np.inf)
-    return total, ratio
+    return ExpandedSums(total, ratio)
 
 
-def groups(factors: np.ndarray, reach: float) -> list[tuple[int, np.ndarray]]:
-    """The factors' split groups, largest first: (spacing K, indices of the factors m with
-    K / ``reach`` < m <= K), K the group's largest factor."""
+class SplitGroup(NamedTuple):
+    """Factors that share one split (:func:`groups`)."""
+
+    #: The knot spacing K: the group's largest factor.
+    spacing: int
+    #: Indices of the group's factors m, K / reach < m <= K.
+    members: np.ndarray
+
+
+def groups(factors: np.ndarray, reach: float) -> list[SplitGroup]:
+    """The factors' :class:`SplitGroup` s, largest first: the spacing K and the indices of the
+    factors m with K / ``reach`` < m <= K, K the group's largest factor."""
     order = np.argsort(-np.asarray(factors), kind="stable")
     out = []
     start = 0
@@ -187,6 +216,6 @@ def groups(factors: np.ndarray, reach: float) -> list[tuple[int, np.ndarray]]:
         stop = start
         while stop < order.size and factors[order[stop]] * reach > spacing:
             stop += 1
-        out.append((spacing, order[start:stop]))
+        out.append(SplitGroup(spacing, order[start:stop]))
         start = stop
     return out

@@ -29,6 +29,8 @@ gap-free, detrended x.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 from scipy import fft
@@ -48,6 +50,31 @@ MAX_RATIO = 1e4
 #: A split group of :func:`theo1_sums` takes the factors down to 1 / SPLIT_REACH of its knot spacing
 #: (random-walk FM: ratio about 5 at the spacing, 1e3 at 1 / 8 of it).
 SPLIT_REACH = 8
+
+
+class Expanded(NamedTuple):
+    """One level's double sum by the expansion and its ratio of the largest terms to it (:func:`theo1_expanded`)."""
+
+    total: float
+    ratio: float
+
+
+class SplitSums(NamedTuple):
+    """Theo1's and the overlapping Allan double sums through the split (:func:`split_sums`), with
+    each one's ratio of the expansion's largest terms to it."""
+
+    theo1: np.ndarray
+    theo1_ratios: np.ndarray
+    allan: np.ndarray
+    allan_ratios: np.ndarray
+
+
+class Theo1Sums(NamedTuple):
+    """Theo1's double sums at every level (:func:`theo1_sums`)."""
+
+    sums: np.ndarray
+    #: How many levels took an expansion (whole or split) rather than the direct sum.
+    n_expanded: int
 
 
 @njit(cache=True)
@@ -103,7 +130,7 @@ def prepare(x: np.ndarray, h_max: int, autocorr: np.ndarray | None = None) -> tu
     return (x, reverse, squares, autocorr, phi_sums(x, h_max + 1), phi_sums(reverse, h_max + 1))
 
 
-def theo1_expanded(prepared: tuple, m: int) -> tuple[float, float]:
+def theo1_expanded(prepared: tuple, m: int) -> Expanded:
     """Theo1's double sum at even m (see the module) and the ratio of the expansion's largest
     terms (the square terms, or sum(x^2) sum w_a) to it: the result has about ``eps * ratio``
     relative error. ``prepared``: :func:`prepare` with h_max >= m / 2."""
@@ -113,11 +140,11 @@ def theo1_expanded(prepared: tuple, m: int) -> tuple[float, float]:
     total = square + 2.0 * lags + 2.0 * pairs - 2.0 * (ends + corners)
     weight = float(np.sum(1.0 / np.arange(1, m // 2 + 1)))
     ratio = max(square, weight * squares[-1]) / total if total > 0 else np.inf
-    return total, ratio
+    return Expanded(total, ratio)
 
 
 def split_sums(x: np.ndarray, factors: np.ndarray, reach: float,
-               allan: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+               allan: np.ndarray | None = None) -> SplitSums:
     """Theo1's double sums at the even ``factors`` by the broken-line split of
     :mod:`avar._kernels.total.split` and each one's ratio (as :func:`theo1_expanded`), then the
     overlapping Allan sums at the factors ``allan`` (span 2m; none by default) and their ratios
@@ -134,15 +161,15 @@ def split_sums(x: np.ndarray, factors: np.ndarray, reach: float,
     ratios = np.empty(spans.size)
     for spacing, members in groups(spans, reach):
         parts = split_parts(x, spacing)
-        r = parts[0]
+        r = parts.rest
         autocorr = short_autocorrelation(r, spacing + 1)  # lags up to the spacing only
         theo, pairs = members[members < factors.size], members[members >= factors.size]
         diagonals = None
         if theo.size >= EVERY_LEVELS or pairs.size:
             diagonals = lag_diagonals(r, np.ascontiguousarray(r[::-1]), spacing // 2 + 1)
         if theo.size >= EVERY_LEVELS:
-            every, every_ratio = theo1_every(r, spacing, autocorr, diagonals)
-            rest, rest_ratio = every[spans[theo]], every_ratio[spans[theo]]
+            every = theo1_every(r, spacing, autocorr, diagonals)
+            rest, rest_ratio = every.sums[spans[theo]], every.ratios[spans[theo]]
         elif theo.size:
             prepared = prepare(r, spacing // 2, autocorr)
             rest, rest_ratio = np.array([theo1_expanded(prepared, int(m)) for m in spans[theo]]).reshape(-1, 2).T
@@ -151,11 +178,11 @@ def split_sums(x: np.ndarray, factors: np.ndarray, reach: float,
         if pairs.size:
             rest, rest_ratio = oavar_expanded(r, spans[pairs] // 2, autocorr, diagonals)
             sums[pairs], ratios[pairs] = combine(rest, rest_ratio, parts, spacing, spans[pairs], allan=True)
-    return sums[: factors.size], ratios[: factors.size], sums[factors.size :], ratios[factors.size :]
+    return SplitSums(sums[: factors.size], ratios[: factors.size], sums[factors.size :], ratios[factors.size :])
 
 
 def theo1_sums(x: np.ndarray, factors: np.ndarray, direct,
-               autocorr: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+               autocorr: np.ndarray | None = None) -> Theo1Sums:
     """Theo1's double sums of gap-free ``x`` at the even ``factors``: directly (``direct(x, m)``)
     where that is cheap, else by :func:`theo1_expanded` (or :func:`avar._kernels.total.theobr.theo1_every`
     for :data:`EVERY_LEVELS` levels or more); a level whose ratio exceeds :data:`MAX_RATIO` by
@@ -176,7 +203,7 @@ def theo1_sums(x: np.ndarray, factors: np.ndarray, direct,
     retry = []
     for level, m in enumerate(factors.tolist()):
         if long[level]:
-            total, ratio = (every[0][m], every[1][m]) if every is not None else theo1_expanded(prepared, m)
+            total, ratio = (every.sums[m], every.ratios[m]) if every is not None else theo1_expanded(prepared, m)
             if ratio <= MAX_RATIO:
                 sums[level] = total
                 expanded += 1
@@ -185,11 +212,11 @@ def theo1_sums(x: np.ndarray, factors: np.ndarray, direct,
             continue
         sums[level] = direct(x, m)
     if retry:
-        split, ratios = split_sums(x, factors[retry], SPLIT_REACH)[:2]
-        for level, total, ratio in zip(retry, split.tolist(), ratios.tolist()):
+        split = split_sums(x, factors[retry], SPLIT_REACH)
+        for level, total, ratio in zip(retry, split.theo1.tolist(), split.theo1_ratios.tolist()):
             if ratio <= MAX_RATIO:
                 sums[level] = total
                 expanded += 1
             else:
                 sums[level] = direct(x, int(factors[level]))
-    return sums, expanded
+    return Theo1Sums(sums, expanded)

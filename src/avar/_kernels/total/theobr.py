@@ -23,6 +23,7 @@ gap-free, detrended x.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -30,6 +31,7 @@ from scipy import fft
 
 from avar._kernels.runtime.tasks import run_concurrently
 from avar._kernels.total.fft import half_convolution, hankel_lower, phi_sums
+from avar._kernels.total.split import ExpandedSums
 
 #: Step (in log t) of the exponential sum: its relative error is below 5e-16 at 0.25.
 _STEP = 0.25
@@ -125,12 +127,20 @@ def _running_sums(x, reverse, autocorr, rest, diag, diag_reverse, count, t, w):
     return out
 
 
-def lag_diagonals(x: np.ndarray, reverse: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+class LagDiagonals(NamedTuple):
+    """D(a) = sum_{j<a} x_j x_{j+a} of a record and of its reverse (:func:`lag_diagonals`)."""
+
+    forward: np.ndarray
+    reverse: np.ndarray
+
+
+def lag_diagonals(x: np.ndarray, reverse: np.ndarray, count: int) -> LagDiagonals:
     """D(a) = sum_{j<a} x_j x_{j+a} of x and of its reverse, a = 0 .. count - 1 (FFT; the two at once)."""
-    return tuple(run_concurrently(lambda: hankel_lower(x, x, count), lambda: hankel_lower(reverse, reverse, count)))
+    return LagDiagonals(*run_concurrently(lambda: hankel_lower(x, x, count),
+                                          lambda: hankel_lower(reverse, reverse, count)))
 
 
-def theo1_every(x: np.ndarray, largest: int, autocorr: np.ndarray, diagonals: tuple) -> tuple[np.ndarray, np.ndarray]:
+def theo1_every(x: np.ndarray, largest: int, autocorr: np.ndarray, diagonals: LagDiagonals) -> ExpandedSums:
     """Theo1's double sums at m = 0 .. ``largest`` (meaningful at even m >= 2, ``largest`` <= N - 1)
     and each one's ratio of the expansion's largest terms to it (about its relative error over eps).
 
@@ -166,7 +176,7 @@ def theo1_every(x: np.ndarray, largest: int, autocorr: np.ndarray, diagonals: tu
     total = square + 2.0 * cross + 2.0 * (pairs + long) - 2.0 * corners
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(total > 0, np.maximum(square, weight * squares[-1]) / total, np.inf)
-    return total, ratio
+    return ExpandedSums(total, ratio)
 
 
 @njit(cache=True, nogil=True)
@@ -185,7 +195,7 @@ def oavar_sums(x: np.ndarray, factors: np.ndarray) -> np.ndarray:
 
 
 def oavar_expanded(x: np.ndarray, factors: np.ndarray, autocorr: np.ndarray,
-                   diagonals: tuple) -> tuple[np.ndarray, np.ndarray]:
+                   diagonals: LagDiagonals) -> ExpandedSums:
     """:func:`oavar_sums` in O(1) per level and each sum's conditioning (its square terms
     over it): the sum of x_i^2 + 4 x_{i+m}^2 + x_{i+2m}^2, less 4 (2 F[m] - D(m) - D~(m)),
     plus 2 F[2m], with D, D~ the :func:`lag_diagonals` (count > max factor)."""
@@ -194,7 +204,7 @@ def oavar_expanded(x: np.ndarray, factors: np.ndarray, autocorr: np.ndarray,
     m = np.asarray(factors, dtype=np.int64)
     n = n_points - 2 * m
     square = squares[n] + 4.0 * (squares[n + m] - squares[m]) + (squares[n_points] - squares[2 * m])
-    out = square - 4.0 * (2.0 * autocorr[m] - diagonals[0][m] - diagonals[1][m]) + 2.0 * autocorr[2 * m]
+    out = square - 4.0 * (2.0 * autocorr[m] - diagonals.forward[m] - diagonals.reverse[m]) + 2.0 * autocorr[2 * m]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(out != 0, (square + 8.0 * squares[-1]) / np.abs(out), np.inf)
-    return out, ratio
+    return ExpandedSums(out, ratio)

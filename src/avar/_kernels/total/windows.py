@@ -29,11 +29,27 @@ as the serial loop.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from avar._kernels.runtime.tasks import run_ranges
 from avar._kernels.total.blocks import level_sum
+
+
+class LevelSum(NamedTuple):
+    """One level's double sum and the number of terms (windows, or Theo1's outer terms) in it."""
+
+    total: float
+    n_terms: int
+
+
+class LevelSums(NamedTuple):
+    """Every level's double sum and the number of terms in it."""
+
+    sums: np.ndarray
+    n_terms: np.ndarray
 
 
 @njit(cache=True)
@@ -219,31 +235,31 @@ def _level(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, n
     return _level_serial(kind, values, m, bad, shift, n_terms)
 
 
-def mtot_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> tuple[float, int]:
+def mtot_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> LevelSum:
     """MTOTDEV's double sum at factor m: sum over the windows n = 0 .. N - 3m of
     (1 / (6 m)) sum_j ((A_j - 2 B_j + C_j) / m)**2 on the phase window x[n .. n + 3m - 1]
     (detrended, reflected); and the number of windows used."""
-    return _level(0, x, int(m), bad, shift, max(0, x.shape[0] - 3 * int(m) + 1))
+    return LevelSum(*_level(0, x, int(m), bad, shift, max(0, x.shape[0] - 3 * int(m) + 1)))
 
 
-def htot_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> tuple[float, int]:
+def htot_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> LevelSum:
     """HTOTDEV's double sum at factor m on the frequency y_k = x[k + 1] - x[k]: sum over the
     windows n = 0 .. M - 3m (M = N - 1) of (1 / (6 m)) sum_j ((A_j - 2 B_j + C_j) / m)**2
     on y[n .. n + 3m - 1] (detrended, reflected); and the number of windows used."""
     y = np.ascontiguousarray(np.diff(x))
-    return _level(1, y, int(m), bad, shift, max(0, y.shape[0] - 3 * int(m) + 1))
+    return LevelSum(*_level(1, y, int(m), bad, shift, max(0, y.shape[0] - 3 * int(m) + 1)))
 
 
-def theo1_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> tuple[float, int]:
+def theo1_sum(x: np.ndarray, m: int, bad: np.ndarray, shift: int) -> LevelSum:
     """Theo1's double sum at even factor m::
 
         sum_{i=0}^{N-m-1} sum_{d=0}^{m/2-1} ((x_i - x_{i-d+m/2}) + (x_{i+m} - x_{i+d+m/2}))**2 / (m/2 - d)
 
     and the number of outer terms i used."""
-    return _level(2, x, int(m), bad, shift, max(0, x.shape[0] - int(m)))
+    return LevelSum(*_level(2, x, int(m), bad, shift, max(0, x.shape[0] - int(m))))
 
 
-def level_sums(kind: int, x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int):
+def level_sums(kind: int, x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int) -> LevelSums:
     """``kind`` 0: :func:`mtot_sum`, 1: :func:`htot_sum`, 2: :func:`theo1_sum` at every factor."""
     values = np.ascontiguousarray(np.diff(x)) if kind == 1 else x
     sums = np.zeros(factors.shape[0])
@@ -251,4 +267,4 @@ def level_sums(kind: int, x: np.ndarray, factors: np.ndarray, bad: np.ndarray, s
     for level, m in enumerate(factors.tolist()):
         n_terms = values.shape[0] - (3 * m - 1 if kind < 2 else m)
         sums[level], counts[level] = _level(kind, values, m, bad, shift, max(0, n_terms))
-    return sums, counts
+    return LevelSums(sums, counts)

@@ -84,41 +84,65 @@ def basic_sums(j, m, s, f, alpha, d, norm, denominator, out):
         out[i] = total / (scale * scale * denominator[i])
 
 
-#: Up to this many rows :func:`greenhall_sums` takes NumPy's sums (nothing to compile;
-#: a noise report's levels); more rows (every tau of a long series) the compiled loops, or
-#: NumPy's up to NUMPY_COLD_ROWS while they are not compiled yet (:mod:`avar._kernels.runtime.paths`).
+#: :func:`greenhall_sums` takes the compiled loops once they are compiled (in this process or
+#: numba's cache: 10 to 100 times faster than NumPy's sums), and NumPy's up to NUMPY_COLD_ROWS rows
+#: while they are not (:mod:`avar._kernels.runtime.paths`: nothing to compile for a first call).
+#: NUMPY_ROWS: the rows of a typical call (a long record's octave levels, a noise report's).
 NUMPY_ROWS = 256
 NUMPY_COLD_ROWS = 1 << 14
+#: The dispatch's route (:func:`avar._kernels.runtime.paths.numpy_path`): one set lookup once compiled.
+_ROUTE = ("greenhall_sums",)
+
+
+def _sw_branch(t, a, alpha):
+    """:func:`_sw` of the one noise exponent ``alpha`` (an int) elementwise: only its own power."""
+    if alpha in (1, -1, -3):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            log = np.where(a > 0.0, np.log(np.where(a > 0.0, a, 1.0)), 0.0)
+        return t**2 * log if alpha == 1 else (-(t**4) * log if alpha == -1 else t**6 * log)
+    if alpha == 2:
+        return -a
+    if alpha == 0:
+        return a**3
+    return -(a**5) if alpha == -2 else a**7
 
 
 def _numpy_sw(t, alpha):
-    """:func:`_sw` elementwise."""
+    """:func:`_sw` elementwise (each element's own exponent, computed for its group of exponents only)."""
     a = np.abs(t)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log = np.where(a > 0.0, np.log(np.where(a > 0.0, a, 1.0)), 0.0)
-    return np.select([alpha == 2, alpha == 1, alpha == 0, alpha == -1, alpha == -2, alpha == -3],
-                     [-a, t**2 * log, a**3, -(t**4) * log, -(a**5), t**6 * log], a**7)
+    values = np.unique(alpha)
+    if values.size == 1:
+        return _sw_branch(t, a, int(values[0])) + np.zeros(np.broadcast(t, alpha).shape)
+    t, a, alpha = np.broadcast_arrays(t, a, alpha)
+    out = np.empty(t.shape)
+    for value in values.tolist():
+        where = alpha == value
+        out[where] = _sw_branch(t[where], a[where], int(value))
+    return out
 
 
 def _numpy_sz(t, f, alpha, d):
     """:func:`sz` elementwise (the same terms in the same order)."""
     finite = np.isfinite(f)
+    every, some = bool(np.all(finite)), bool(np.any(finite))
     h = np.where(finite, 1.0 / np.where(finite, f, 1.0), 0.0)
     ff = np.where(finite, f, 0.0)
     total = np.zeros(np.broadcast(t, f, alpha).shape)
     for k in range(-d, d + 1):
         s = t + k
-        sx = np.where(finite, ff * ff * (2.0 * _numpy_sw(s, alpha) - _numpy_sw(s - h, alpha) - _numpy_sw(s + h, alpha)),
-                      _numpy_sw(s, alpha + 2))
+        if some:
+            sx = ff * ff * (2.0 * _numpy_sw(s, alpha) - _numpy_sw(s - h, alpha) - _numpy_sw(s + h, alpha))
+        if not every:
+            sx = np.where(finite, sx, _numpy_sw(s, alpha + 2)) if some else _numpy_sw(s, alpha + 2)
         total += (1.0 if k % 2 == 0 else -1.0) * _BINOMIAL[d, d + k] * sx
     return total
 
 
 def greenhall_sums(j, m, s, f, alpha, d, norm, denominator):
-    """:func:`basic_sums` of every row, returned: in NumPy for at most :data:`NUMPY_ROWS`
-    rows (at most J_max + 1 lags each; up to :data:`NUMPY_COLD_ROWS` while the loops are not
-    compiled yet), else by the compiled loops."""
-    if j.shape[0] > NUMPY_ROWS and not numpy_path(j.shape[0], NUMPY_COLD_ROWS, (basic_sums,)):
+    """:func:`basic_sums` of every row, returned: by the compiled loops, or in NumPy (at most
+    J_max + 1 lags a row) for up to :data:`NUMPY_COLD_ROWS` rows while the loops are not compiled
+    yet (or when NumPy is forced)."""
+    if not numpy_path(j.shape[0], NUMPY_COLD_ROWS, (basic_sums,), route=_ROUTE):
         out = np.empty(j.shape[0])
         basic_sums(j, m, s, f, alpha, d, norm, denominator, out)
         return out

@@ -91,11 +91,17 @@ def _projections(x, m, k, half, c2):
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
 def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
-    """Stats of the differences of orders ``low`` and ``low + 1`` (0 or 2) of the residuals, streamed."""
+    """Stats of the differences of orders ``low`` and ``low + 1`` (0 or 2) of the residuals, streamed:
+    per order, the sum, sum of squares, lag-1 sum of products, first and last value of its values
+    less its first one (the lag-1 statistic is unchanged by the shift, and a constant far above the
+    noise, such as the second differences of a large frequency drift, cancels exactly first)."""
     ta = tb = qa = qb = pa = pb = 0.0
     w0 = w1 = w2 = w3 = 0.0  # the latest value of every order
     fa = fb = 0.0
-    for i in range(k):
+    sa = sb = 0.0  # every order's sums are of its values less its first value: a drift's constant
+    # difference (or any offset far above the noise) then cancels before the squares, not in them
+    head = min(k, low + 2)
+    for i in range(head):  # the first points, where the orders start: branches
         t = i - half
         v0 = x[i * m] - (a0 + a1 * t + a2 * (t * t - c2))
         v1 = v0 - w0
@@ -105,6 +111,14 @@ def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
             va, vb, ua, ub = v0, v1, w0, w1
         else:
             va, vb, ua, ub = v2, v3, w2, w3
+        if i == low:
+            sa = va
+        if i == low + 1:
+            sb = vb
+        va -= sa
+        vb -= sb
+        ua -= sa
+        ub -= sb
         pa += ua * va
         pb += ub * vb
         ta += va
@@ -112,20 +126,52 @@ def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
         qa += va * va
         qb += vb * vb
         w0, w1, w2, w3 = v0, v1, v2, v3
-        if i <= low + 1:  # order d starts at point d: drop what came before
-            if i < low:
-                ta = qa = pa = 0.0
-            elif i == low:
-                fa = va
-                pa = 0.0
-            if i <= low:
-                tb = qb = pb = 0.0
-            else:
-                fb = vb
-                pb = 0.0
-    stats[low, 0], stats[low, 1], stats[low, 2], stats[low, 3], stats[low, 4] = ta, qa, pa, fa, w0 if low == 0 else w2
+        if i < low:  # order d starts at point d: drop what came before
+            ta = qa = pa = 0.0
+        elif i == low:
+            fa = va
+            pa = 0.0
+        if i <= low:
+            tb = qb = pb = 0.0
+        else:
+            fb = vb
+            pb = 0.0
+    if low == 0:  # no branch in the loops over the rest
+        ua, ub = w0 - sa, w1 - sb
+        for i in range(head, k):
+            t = i - half
+            v0 = x[i * m] - (a0 + a1 * t + a2 * (t * t - c2))
+            v1 = v0 - w0
+            va = v0 - sa
+            vb = v1 - sb
+            pa += ua * va
+            pb += ub * vb
+            ta += va
+            tb += vb
+            qa += va * va
+            qb += vb * vb
+            w0, w1, ua, ub = v0, v1, va, vb
+    else:
+        ua, ub = w2 - sa, w3 - sb
+        for i in range(head, k):
+            t = i - half
+            v0 = x[i * m] - (a0 + a1 * t + a2 * (t * t - c2))
+            v1 = v0 - w0
+            v2 = v1 - w1
+            v3 = v2 - w2
+            va = v2 - sa
+            vb = v3 - sb
+            pa += ua * va
+            pb += ub * vb
+            ta += va
+            tb += vb
+            qa += va * va
+            qb += vb * vb
+            w0, w1, w2, w3, ua, ub = v0, v1, v2, v3, va, vb
+    stats[low, 0], stats[low, 1], stats[low, 2], stats[low, 3] = ta, qa, pa, fa
+    stats[low, 4] = (w0 if low == 0 else w2) - sa
     stats[low + 1, 0], stats[low + 1, 1], stats[low + 1, 2] = tb, qb, pb
-    stats[low + 1, 3], stats[low + 1, 4] = fb, w1 if low == 0 else w3
+    stats[low + 1, 3], stats[low + 1, 4] = fb, (w1 if low == 0 else w3) - sb
 
 
 @njit(cache=True, nogil=True)
@@ -250,7 +296,8 @@ def lag1_alpha_from_moments(row, dmax):
     The lag-1 sum of products of each order of differences w follows from sums
     of squares: sum w_i w_{i+1} = (2 sum w^2 - w_first^2 - w_last^2 - sum (dw)^2) / 2.
     Returns NaN for a constant series and :data:`ILL_CONDITIONED` when a sum it
-    needs lost more than log10(:data:`KAPPA_MAX`) digits to cancellation.
+    needs lost more than log10(:data:`KAPPA_MAX`) digits to cancellation (the sums of
+    squares derived from raw ones, or the variance about a mean far above the noise).
     """
     length = row[0] + 1.0
     total, squares, first, last, raw = _order_stats(row, 0)
@@ -260,6 +307,8 @@ def lag1_alpha_from_moments(row, dmax):
             return ILL_CONDITIONED
         mean = total / length
         power = squares - total * mean
+        if squares > 0.0 and not power > squares / KAPPA_MAX:  # a mean far above the noise (the
+            return ILL_CONDITIONED  # constant second differences of a large drift) took its digits
         if not power > 0.0:
             return np.nan
         products = (2.0 * squares - first * first - last * last - n_squares) / 2.0

@@ -4,5 +4,5 @@
 * :mod:`avar.fit.report.sensor_fit`, :mod:`~avar.fit.report.sensor_terms`: the noise model chosen by the data;
 * :mod:`avar.fit.report.rows`, :mod:`~avar.fit.report.noise_terms`: terms in SI and customary units;
 * :mod:`avar.fit.report.checks`: the fit check and the warnings;
-* :mod:`avar.fit.report.result`: :class:`NoiseReport`; :mod:`avar.fit.report.kalibr`: the Kalibr ``imu.yaml``.
+* :mod:`avar.fit.report.result`: :class:`NoiseReport`; :mod:`avar.fit.report.exports`: the Kalibr ``imu.yaml`` and every estimator's IMU file.
 """

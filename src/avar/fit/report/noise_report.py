@@ -152,7 +152,9 @@ def fit_channel(av: AllanVariance, significance: float) -> FittedChannel:
     The fit weighs the levels by their degrees of freedom (N - 2m + 1) / m;
     the band uses Greenhall's EDF of the overlapping Allan variance at the
     noise type of the fitted model's local slope (the power-law noise exponent
-    alpha = -1 - d log AV / d log tau, rounded into -2..2). When the selected model fits fewer than 90 % of
+    alpha = -1 - d log AV / d log tau, rounded into -2..2). The long-tau terms (random walk, a long
+    Gauss-Markov term, flicker) are chosen on the levels' exact likelihood for the record's length
+    (:mod:`avar.fit.report.long_tau`). When the selected model fits fewer than 90 % of
     the levels, the selection is extended by the terms the data demand (``check`` of
     :func:`~avar.fit.report.sensor_fit.fit_sensor_model`). The parameters'
     covariance is the sandwich around the exact covariance of the
@@ -164,14 +166,14 @@ def fit_channel(av: AllanVariance, significance: float) -> FittedChannel:
     factors = np.asarray(av.averaging_factors, dtype=np.int64)
     counts = np.maximum(av.n - 2 * factors + 1, 1)
     nu_hat, adev = np.asarray(av.allan, dtype=np.float64), np.asarray(av.adev, dtype=np.float64)
-    fit = fit_sensor_model(factors, nu_hat, counts / factors)
+    fit = fit_sensor_model(factors, nu_hat, counts / factors, n_samples=av.n)
     lower, upper, edf = _band(av, fit.implied(factors), significance)
 
     def share(implied: np.ndarray) -> float:
         return float(np.mean(fit_check("", av.levels, adev, lower, upper, np.sqrt(implied)).fits))
 
     if share(fit.implied(factors)) < FIT_SHARE:
-        fit = fit_sensor_model(factors, nu_hat, counts / factors, check=share)
+        fit = fit_sensor_model(factors, nu_hat, counts / factors, check=share, n_samples=av.n)
         lower, upper, edf = _band(av, fit.implied(factors), significance)
     if av.type != "mo":  # the exact covariance is the maximal-overlap estimator's
         return FittedChannel(non_overlapping_fit(fit, av.n, 2.0 * fit.implied(factors) ** 2 / edf), lower, upper)
@@ -224,12 +226,16 @@ def noise_report(
     * quantization Q, angle / velocity random walk N, bias instability B
       (IEEE 952: the flicker plateau of the Allan deviation is 0.664 B),
       rate / acceleration random walk K, ramp R, each ``present``,
-      ``bound`` (N, B, K left out by the selection: their upper bound) or
-      ``absent``::
+      ``bound`` (N, B, K left out by the selection: the upper end of their interval,
+      worded ``one-sided 97.5 % upper bound`` at confidence 0.95,
+      :func:`avar.fit.report.rows.bound_words`) or ``absent``::
 
           AV(tau) = 3 Q^2 / tau^2 + N^2 / tau + (2 ln 2 / pi) B^2 + K^2 tau / 3 + R^2 tau^2 / 2 + ...
 
-    * Gauss-Markov sigma and correlation time, sinusoid amplitude and frequency;
+    * Gauss-Markov sigma and correlation time, sinusoid amplitude and frequency; those
+      of the sensor's own filtering or vibration (a deviation peaking within 16 sample
+      periods) in the ``Group`` "sensor filtering", the rest "IEEE 952"
+      (:func:`avar.fit.report.rows.group_of`);
     * the **Allan-deviation minimum** and its tau (the "in-run bias stability"
       of datasheets), also in deg/h or ug.
 
@@ -346,7 +352,7 @@ def noise_report(
                                    density, from_bag)
         for note in notes:
             rows.append({"Channel": channel, "Sensor": kind or "", "Term": "Warning", "Process": "WARNING",
-                         "Status": "warning", "Note": note})
+                         "Status": "warning", "Group": "", "Note": note})
         warnings += notes
         curves.append(pd.DataFrame({"Channel": channel, "Tau (s)": av.levels, "ADEV": av.adev, "Lower": lower,
                                     "Upper": upper, "Implied ADEV": implied, "Fits": fits_level,

@@ -6,7 +6,7 @@ Every term is a coefficient theta of an Allan deviation AD(tau) = c theta tau^b
 * QN, quantization Q: AD = sqrt(3) Q / tau, Q in u s;
 * WN, angle random walk N: AD = N / sqrt(tau), N in u s^1/2 = u / sqrt(Hz);
 * FN, bias instability B: AD = 0.664 B (flat), B in u;
-* RW, rate random walk K: AD = K sqrt(tau / 3), K in u / s^1/2 = u sqrt(Hz) / s;
+* RW, rate random walk K: AD = K sqrt(tau / 3), K in u s^-1/2 = u / s / sqrt(Hz);
 * DR, rate ramp R: AD = R tau / sqrt(2), R in u / s.
 
 For an accelerometer the names are velocity random walk, bias instability,
@@ -16,7 +16,11 @@ deg/sqrt(h) = N[deg/s] * 60, bias instability deg/h = B[deg/s] * 3600, rate
 random walk deg/h/sqrt(h) = K[deg/s/sqrt(s)] * 3600 * 60; velocity random walk
 m/s/sqrt(h) = N[m/s^2] * 60, bias instability ug = B / (9.80665e-6 m/s^2),
 acceleration random walk m/s^2/sqrt(h) = K * 60. N in u/sqrt(Hz) and K in
-u sqrt(Hz)/s are Kalibr's ``*_noise_density`` and ``*_random_walk``.
+u/s/sqrt(Hz) are Kalibr's ``*_noise_density`` and ``*_random_walk``.
+
+A coefficient's unit follows from its definition: AD(tau) = c theta tau^b in u with
+tau in s makes theta u s^-b (b = the term's slope: QN -1, WN -1/2, FN 0, RW 1/2,
+DR 1), written with Hz = 1/s as above.
 
 References
 ----------
@@ -58,8 +62,8 @@ TERM_NAMES = {
     None: {"QN": "Quantization", "WN": "White noise", "FN": "Bias instability (flicker)",
            "RW": "Random walk", "DR": "Ramp"},
 }
-#: Coefficient units with u the data unit (s: seconds).
-GENERIC_UNITS = {"QN": "{u} s", "WN": "{u}/sqrt(Hz)", "FN": "{u}", "RW": "{u}*sqrt(Hz)/s", "DR": "{u}/s"}
+#: Coefficient units with u the data unit (s: seconds; u s^-b for a term of slope b, sqrt(Hz) = s^-1/2).
+GENERIC_UNITS = {"QN": "{u} s", "WN": "{u}/sqrt(Hz)", "FN": "{u}", "RW": "{u}/s/sqrt(Hz)", "DR": "{u}/s"}
 #: SI coefficient units.
 SI_UNITS = {
     GYRO: {"QN": "rad", "WN": "rad/s/sqrt(Hz)", "FN": "rad/s", "RW": "rad/s^2/sqrt(Hz)", "DR": "rad/s^2"},

@@ -4,7 +4,7 @@ Holds numbers only: the Allan variance and the selected model of every
 channel, the table of terms, the curves (empirical deviation, band, implied
 deviation) and the warnings. ``plot()`` draws the report
 figure (:mod:`avar.plotting.report`), ``to_kalibr(path)`` writes a Kalibr
-``imu.yaml`` (:mod:`avar.fit.report.kalibr`).
+``imu.yaml`` and ``export(name, path)`` each estimator's own file (:mod:`avar.fit.report.exports`).
 """
 
 from __future__ import annotations
@@ -25,12 +25,32 @@ __all__ = ["NoiseReport"]
 
 #: Columns of :attr:`NoiseReport.table`.
 TABLE_COLUMNS = ["Channel", "Sensor", "Term", "Process", "Status", "Value", "Lower", "Upper", "Unit",
-                 "Customary", "Customary lower", "Customary upper", "Customary unit", "Tau (s)", "Note"]
+                 "Customary", "Customary lower", "Customary upper", "Customary unit", "Tau (s)", "Group", "Note"]
 NUMERIC_COLUMNS = ["Value", "Lower", "Upper", "Customary", "Customary lower", "Customary upper", "Tau (s)"]
 
 
 def _number(value: Any) -> str:
     return "none" if value is pd.NA or value is None else f"{value:.4g}"
+
+
+def _line(row: pd.Series, bound: str) -> str:
+    """One row of the printed summary."""
+    if row["Status"] == "warning":
+        return f"  warning: {terminal(row['Note'])}"
+    if row["Status"] == "absent":
+        return f"  {row['Term']:<34} absent"
+    if row["Status"] == "bound":
+        text = f"  {row['Term']:<34} < {_number(row['Upper'])} {row['Unit']} ({bound}, not resolved)"
+        if row["Customary unit"]:
+            text += f" = < {_number(row['Customary upper'])} {row['Customary unit']}"
+        return text
+    text = (f"  {row['Term']:<34} {_number(row['Value'])} {row['Unit']} "
+            f"[{_number(row['Lower'])}, {_number(row['Upper'])}]")
+    if row["Customary unit"]:
+        text += f" = {_number(row['Customary'])} {row['Customary unit']}"
+    if row["Tau (s)"] is not pd.NA and row["Process"] == "MIN":
+        text += f" at tau = {row['Tau (s)']:.4g} s"
+    return text
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,7 +130,9 @@ class NoiseReport:
         """One row per channel and term: status (``present``, ``bound``, ``absent``, ``measured`` for
         the Allan-deviation minimum, ``warning``), value, interval (a bound: 0 to its upper bound),
         unit (SI when the sensor type is known), the same in customary units, a tau (the minimum's,
-        a Gauss-Markov correlation time, a sinusoid's period) and a note. Missing values are <NA>."""
+        a Gauss-Markov correlation time, a sinusoid's period), the group (``IEEE 952``, or ``sensor
+        filtering`` for a term of the sensor's own filtering or vibration; :func:`avar.fit.report.rows.group_of`)
+        and a note. Missing values are <NA>."""
         return self.terms.copy()
 
     def summary(self) -> pd.DataFrame:
@@ -152,22 +174,29 @@ class NoiseReport:
         raise ValueError(f"implied must be 'sum' (sum of the processes' variances) or 'r' (R's curve), got {implied!r}")
 
     def kalibr(self, **overrides: Any) -> dict[str, Any]:
-        """The Kalibr ``imu.yaml`` fields; see :func:`avar.fit.report.kalibr.kalibr_fields`."""
-        from avar.fit.report.kalibr import kalibr_fields
+        """The Kalibr ``imu.yaml`` fields; see :func:`avar.fit.report.exports.kalibr.kalibr_fields`."""
+        from avar.fit.report.exports.kalibr import kalibr_fields
 
         return kalibr_fields(self, **overrides)
 
-    def kalibr_text(self, axis: str = "max", **overrides: Any) -> str:
-        """The Kalibr ``imu.yaml`` text with its comments; see :func:`avar.fit.report.kalibr.kalibr_text`."""
-        from avar.fit.report.kalibr import kalibr_text
+    def kalibr_text(self, axis: str = "max", inflate: float = 1.0, **overrides: Any) -> str:
+        """The Kalibr ``imu.yaml`` text with its comments; see :func:`avar.fit.report.exports.kalibr.kalibr_text`."""
+        from avar.fit.report.exports.kalibr import kalibr_text
 
-        return kalibr_text(self, axis=axis, **overrides)
+        return kalibr_text(self, axis=axis, inflate=inflate, **overrides)
 
     def to_kalibr(self, path: Any, force: bool = False, **overrides: Any) -> Any:
-        """Write a Kalibr ``imu.yaml``; see :func:`avar.fit.report.kalibr.write_kalibr`."""
-        from avar.fit.report.kalibr import write_kalibr
+        """Write a Kalibr ``imu.yaml``; see :func:`avar.fit.report.exports.kalibr.write_kalibr`."""
+        from avar.fit.report.exports.kalibr import write_kalibr
 
         return write_kalibr(self, path, force=force, **overrides)
+
+    def export(self, name: str, path: Any = None, axis: str = "max", inflate: float = 1.0, force: bool = False) -> str:
+        """An estimator's IMU file (``kalibr``, ``openvins``, ``vins``, ``orbslam3``, ``basalt``, ``matlab``):
+        its text, written to ``path`` when given; see :func:`avar.fit.report.exports.registry.export`."""
+        from avar.fit.report.exports.registry import export
+
+        return export(self, name, path, axis=axis, inflate=inflate, force=force)
 
     def plot(self, **kwargs: Any):
         """Allan deviation of every channel with the fitted terms; see :func:`avar.plotting.report.plot_report`."""
@@ -181,30 +210,20 @@ class NoiseReport:
                 f"freq = {format_frequency(self.rate)}, {100 * self.confidence:g}% chi-squared intervals")
 
     def __str__(self) -> str:
+        from avar.fit.report.rows import SENSOR_FILTERING, bound_words
+
         lines = [self.describe()]
         for channel, kind in zip(self.channels, self.sensor_types):
             lines.append(f"\n{terminal(channel)}" + (f" ({kind.lower()})" if kind else ""))
             rows = self.terms[self.terms["Channel"] == channel]
-            for _, row in rows.iterrows():
-                if row["Status"] == "warning":
-                    lines.append(f"  warning: {terminal(row['Note'])}")
-                    continue
-                if row["Status"] == "absent":
-                    lines.append(f"  {row['Term']:<34} absent")
-                    continue
-                if row["Status"] == "bound":
-                    text = f"  {row['Term']:<34} < {_number(row['Upper'])} {row['Unit']} (95 % bound, not resolved)"
-                    if row["Customary unit"]:
-                        text += f" = < {_number(row['Customary upper'])} {row['Customary unit']}"
-                    lines.append(text)
-                    continue
-                text = (f"  {row['Term']:<34} {_number(row['Value'])} {row['Unit']} "
-                        f"[{_number(row['Lower'])}, {_number(row['Upper'])}]")
-                if row["Customary unit"]:
-                    text += f" = {_number(row['Customary'])} {row['Customary unit']}"
-                if row["Tau (s)"] is not pd.NA and row["Process"] == "MIN":
-                    text += f" at tau = {row['Tau (s)']:.4g} s"
-                lines.append(text)
+            filtering = rows["Group"] == SENSOR_FILTERING
+            warned = rows["Status"] == "warning"
+            for group, part in ((None, rows[~filtering & ~warned]), (SENSOR_FILTERING, rows[filtering]),
+                                (None, rows[warned])):
+                if group is not None and len(part):
+                    lines.append(f"  {group} (the sensor's own filtering or vibration, apart from IEEE 952 terms):")
+                indent = "  " if group is not None else ""
+                lines += [indent + _line(row, bound_words(self.confidence)) for _, row in part.iterrows()]
         return "\n".join(lines)
 
     def __repr__(self) -> str:

@@ -10,7 +10,7 @@ term   coefficient                 from the per-sample variance c        unit
 QN     quantization Q              sqrt(c) / f                           u s
 WN     angle/velocity random walk  sqrt(c / f)                           u / sqrt(Hz)
 FN     bias instability B          sqrt(c) (AD plateau 0.664 B)          u
-RW     rate/accel. random walk K   sqrt(c f)                             u sqrt(Hz) / s
+RW     rate/accel. random walk K   sqrt(c f)                             u / s / sqrt(Hz)
 DR     ramp R                      sqrt(c) f                             u / s
 AR1    Gauss-Markov sigma, T       sqrt(c / (1 - phi^2)); -1 / (f ln phi)  u; s
 SIN    sinusoid amplitude, f0      sqrt(2 c); shape * f                  u; Hz
@@ -20,7 +20,22 @@ Intervals: the squared coefficient c with sampling variance v is a scaled
 chi-square with 2 c^2 / v degrees of freedom; shapes get a normal interval
 (on the log scale for a correlation time). A term left out of the model is
 ``absent``, except the three an engineer always needs (N, B, K): those are
-``bound``, with the one-sided 95 % upper bound of the enlarged model.
+``bound``, with the upper end of the enlarged model's interval of the report's
+confidence, worded everywhere by :func:`bound_words` (``one-sided 97.5 % upper
+bound`` at confidence 0.95: the 97.5 % quantile, the upper end of a two-sided
+95 % interval).
+
+**Groups.** Every row is ``IEEE 952`` (the five power laws, the in-run bias
+stability, and Gauss-Markov and sinusoidal terms of the sensor's noise, IEEE 952
+Annex C.1.6-7) or ``sensor filtering``: a term that models the sensor's own
+output filtering or a vibration rather than its noise. A term is sensor filtering
+when its Allan deviation peaks within the first :data:`FILTER_SAMPLES` = 16 sample
+periods (4 octaves of the grid), where a digital sensor's anti-alias and
+decimation filters shape the output and the white noise is not yet read cleanly:
+a Gauss-Markov term of correlation time T <= 16 / (1.89 rate) (its deviation
+peaks at 1.89 T, i.e. T within 8.5 samples of the grid's floor of 1 sample), a
+sinusoid of frequency f0 >= 0.371 rate / 16 = rate / 43 (its deviation peaks at
+0.371 / f0). Exports read the IEEE 952 terms N, B, K only.
 """
 
 from __future__ import annotations
@@ -35,16 +50,51 @@ from avar.fit.report.noise_terms import ACCEL, GYRO, TERM_NAMES, customary, to_s
 from avar.fit.report.sensor_fit import SensorFit, term_bound
 from avar.fit.terms import POWER_LAWS
 
-__all__ = ["channel_rows", "minimum_row", "BOUNDED", "ROW_COLUMNS"]
+__all__ = ["channel_rows", "minimum_row", "bound_words", "group_of", "BOUNDED", "ROW_COLUMNS", "IEEE_952",
+           "SENSOR_FILTERING", "FILTER_SAMPLES"]
 
 #: Terms reported as a bound when the selection leaves them out.
 BOUNDED = ("WN", "FN", "RW")
 ROW_COLUMNS = ["Channel", "Sensor", "Term", "Process", "Status", "Value", "Lower", "Upper", "Unit", "Customary",
-               "Customary lower", "Customary upper", "Customary unit", "Tau (s)", "Note"]
+               "Customary lower", "Customary upper", "Customary unit", "Tau (s)", "Group", "Note"]
+#: The groups of the ``Group`` column.
+IEEE_952, SENSOR_FILTERING = "IEEE 952", "sensor filtering"
+#: A term whose Allan deviation peaks within this many sample periods models the sensor's filtering.
+FILTER_SAMPLES = 16.0
+#: Where the Allan deviation of a Gauss-Markov term (times T) and of a sinusoid (times its period) peaks.
+GAUSS_MARKOV_PEAK, SINUSOID_PEAK = 1.89, 0.371
 #: The coefficient of each IEEE term from its per-sample variance c at f Hz (the process class's ``coefficient``).
 CONVERSIONS = {cls.name: cls.coefficient for cls in POWER_LAWS}
 DEG = math.pi / 180.0
 G0 = 9.80665
+
+
+def bound_words(confidence: float) -> str:
+    """The one wording of a bound of a term the data do not resolve, in every table, printout and export.
+
+    The bound is the upper end of the two-sided interval of ``confidence``: the
+    quantile 1 - (1 - confidence) / 2 of a one-sided bound.
+
+    >>> bound_words(0.95)
+    'one-sided 97.5 % upper bound'
+    """
+    return f"one-sided {100.0 * (1.0 - (1.0 - confidence) / 2.0):g} % upper bound"
+
+
+def group_of(kind: str, shape: float | None) -> str:
+    """``"sensor filtering"`` for a term whose Allan deviation peaks within :data:`FILTER_SAMPLES` samples
+    (a Gauss-Markov term of phi = ``shape``, a sinusoid of ``shape`` cycles per sample), else ``"IEEE 952"``.
+
+    >>> group_of("AR1", math.exp(-1 / 2)), group_of("SIN", 13.5 / 100), group_of("SIN", 0.5 / 100), group_of("WN", None)
+    ('sensor filtering', 'sensor filtering', 'IEEE 952', 'IEEE 952')
+    """
+    if kind == "AR1" and shape is not None and 0.0 < shape < 1.0:
+        peak = GAUSS_MARKOV_PEAK * -1.0 / math.log(shape)
+    elif kind == "SIN" and shape:
+        peak = SINUSOID_PEAK / shape
+    else:
+        return IEEE_952
+    return SENSOR_FILTERING if peak <= FILTER_SAMPLES else IEEE_952
 
 
 def _chi2_interval(c: float, variance: float, significance: float) -> tuple[float, float]:
@@ -58,11 +108,12 @@ def _chi2_interval(c: float, variance: float, significance: float) -> tuple[floa
 
 def _row(channel: str, kind: str | None, term: str, process: str, status: str, unit: str, values: tuple,
          customary_unit: str = "", customary_values: tuple = (pd.NA, pd.NA, pd.NA), tau: Any = pd.NA,
-         note: str = "") -> dict[str, Any]:
+         note: str = "", group: str = IEEE_952) -> dict[str, Any]:
     return {"Channel": channel, "Sensor": kind or "", "Term": term, "Process": process, "Status": status,
             "Value": values[0], "Lower": values[1], "Upper": values[2], "Unit": unit,
             "Customary": customary_values[0], "Customary lower": customary_values[1],
-            "Customary upper": customary_values[2], "Customary unit": customary_unit, "Tau (s)": tau, "Note": note}
+            "Customary upper": customary_values[2], "Customary unit": customary_unit, "Tau (s)": tau,
+            "Group": group, "Note": note}
 
 
 def _ieee_row(channel: str, kind: str | None, unit: str | None, process: str, status: str,
@@ -95,7 +146,7 @@ def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFi
         elif process in BOUNDED:
             bound = convert(max(term_bound(fit, process, 1.0 - significance / 2.0), 0.0), rate)
             rows.append(_ieee_row(channel, kind, unit, process, "bound", (pd.NA, 0.0, bound),
-                                  note=f"not resolved by the data: {100 * (1 - significance / 2):g} % upper bound"))
+                                  note=f"not resolved by the data: {bound_words(1.0 - significance)}"))
         else:
             rows.append(_ieee_row(channel, kind, unit, process, "absent", (pd.NA,) * 3, note="rejected by the selection"))
     data_unit = unit or "u"
@@ -109,10 +160,11 @@ def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFi
         time = -1.0 / (rate * math.log(phi))
         se_log = math.sqrt(max(fit.shape_variance(k), 0.0)) / (phi * abs(math.log(phi)))
         times = (time, time * math.exp(-z * se_log), time * math.exp(z * se_log))
-        label = f"Gauss-Markov {number}"
+        label, group = f"Gauss-Markov {number}", group_of("AR1", phi)
         rows.append(_row(channel, kind, f"{label} sigma", f"AR1_{number}", "present",
-                         _si_unit(kind, unit, data_unit), sigma, tau=time))
-        rows.append(_row(channel, kind, f"{label} correlation time", f"AR1_{number}.T", "present", "s", times))
+                         _si_unit(kind, unit, data_unit), sigma, tau=time, group=group))
+        rows.append(_row(channel, kind, f"{label} correlation time", f"AR1_{number}.T", "present", "s", times,
+                         group=group))
     for number, k in enumerate(by_kind.get("SIN", []), start=1):
         component = fit.components[k]
         c = component.scale
@@ -120,10 +172,11 @@ def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFi
         amplitude = tuple(to_si(math.sqrt(2.0 * v), kind, unit) for v in (c, low, high))
         hertz = component.shape * rate
         spread = z * math.sqrt(max(fit.shape_variance(k), 0.0)) * rate
+        group = group_of("SIN", component.shape)
         rows.append(_row(channel, kind, f"Sinusoid {number} amplitude", f"SIN_{number}", "present",
-                         _si_unit(kind, unit, data_unit), amplitude, tau=1.0 / hertz))
+                         _si_unit(kind, unit, data_unit), amplitude, tau=1.0 / hertz, group=group))
         rows.append(_row(channel, kind, f"Sinusoid {number} frequency", f"SIN_{number}.f", "present", "Hz",
-                         (hertz, max(hertz - spread, 0.0), hertz + spread)))
+                         (hertz, max(hertz - spread, 0.0), hertz + spread), group=group))
     return rows
 
 
@@ -153,12 +206,12 @@ def minimum_row(channel: str, kind: str | None, unit: str | None, tau: np.ndarra
         custom, custom_unit = tuple(v / DEG * 3600.0 for v in si), "deg/h"
     elif kind == ACCEL:
         custom, custom_unit = tuple(v / (G0 * 1e-6) for v in si), "ug"
-    note = "the empirical minimum over the levels with at least 8 clusters, with its chi-squared band"
+    note = f"the empirical minimum over the levels with at least {MIN_CLUSTERS} clusters, with its chi-squared band"
     if overall != at:
         lowest = to_si(float(adev[overall]), kind, unit)
         shown = lowest / DEG * 3600.0 if kind == GYRO else lowest / (G0 * 1e-6) if kind == ACCEL else lowest
         note += (f"; the global minimum {shown:.4g} {custom_unit or _si_unit(kind, unit, unit or 'u')} at "
-                 f"tau = {tau[overall]:g} s averages fewer than 8 clusters")
+                 f"tau = {tau[overall]:g} s averages fewer than {MIN_CLUSTERS} clusters")
     return _row(channel, kind, "AD minimum (in-run bias stability)", "MIN", "measured",
                 _si_unit(kind, unit, unit or "u"), si, custom_unit, custom, tau=float(tau[at]), note=note)
 

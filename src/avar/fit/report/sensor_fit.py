@@ -35,7 +35,9 @@ and two SIN), or drop the term whose removal lowers it most, while one does.
 A ramp is tried only beside a random walk (within one record a random walk
 mimics a ramp, and the stochastic term is the one to report). Given a fit
 check, terms are then added while the model fits fewer than 90 % of the
-levels and an addition raises that share.
+levels and an addition raises that share. Given the record's length, the
+long-tau terms (random walk, a long Gauss-Markov term, flicker) are chosen
+again before that, by their exact likelihood (:mod:`avar.fit.report.long_tau`).
 
 edf_j = (N - 2 m_j + 1) / m_j, the number of nearly independent differences
 of level j (Percival & Walden 2000, sec. 8.4); the parameters' covariance is
@@ -56,6 +58,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from avar.fit.report.long_tau import LONG_KINDS, choose_long_terms
 from avar.fit.report.sandwich import independent_levels, parameter_covariance
 from avar.fit.report.sensor_terms import KINDS, LINEAR, deviance, weight_edf
 from avar.fit.terms import Component, basis
@@ -153,8 +156,10 @@ def _irls(columns: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, iterations: 
 class _Problem:
     """The data of one fit, and the deviance of any set of terms with given shapes."""
 
-    def __init__(self, factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray) -> None:
+    def __init__(self, factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray,
+                 sampling_edf: np.ndarray | None = None) -> None:
         self.factors, self.nu_hat, self.edf = factors, nu_hat, edf
+        self.sampling_edf = edf if sampling_edf is None else sampling_edf
         self._cache: dict[tuple, np.ndarray] = {}
         top = math.log2(max(float(factors[-1]), 2.0))
         exponents = np.arange(0.0, top + 1.0 / GRID_PER_OCTAVE, 1.0 / GRID_PER_OCTAVE)
@@ -300,7 +305,8 @@ def _repair(problem: _Problem, terms: list, kinds: tuple[str, ...], budget: int,
 
 
 def fit_sensor_model(factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, *, penalty: float | None = None,
-                     kinds: tuple[str, ...] = KINDS, check: Callable[[np.ndarray], float] | None = None) -> SensorFit:
+                     kinds: tuple[str, ...] = KINDS, check: Callable[[np.ndarray], float] | None = None,
+                     n_samples: int | None = None) -> SensorFit:
     """Select and fit the noise model of one channel (see the module docstring).
 
     Parameters
@@ -319,6 +325,11 @@ def fit_sensor_model(factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, *
         ``check(implied_av) -> share`` of the levels where a model fits the data. When the selected
         model's share is below 90 %, terms are added (each kind tried, the best share kept) while the
         share rises: the simplest model by the criterion, then as much more as the data demand.
+    n_samples : int, optional
+        The record's length N. Given, the long-tau terms of the selected model (FN, RW, a long
+        Gauss-Markov term) are chosen again among all their subsets by the same criterion on the
+        levels' exact likelihood, a candidate that passes ``check`` first
+        (:func:`avar.fit.report.long_tau.choose_long_terms`).
 
     Returns
     -------
@@ -336,7 +347,7 @@ def fit_sensor_model(factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, *
     nu_hat = np.asarray(nu_hat, dtype=np.float64)
     sampling_edf = np.maximum(np.asarray(edf, dtype=np.float64), 1.0)
     edf = weight_edf(sampling_edf)
-    problem = _Problem(factors, nu_hat, edf)
+    problem = _Problem(factors, nu_hat, edf, sampling_edf)
     penalty = math.log(float(np.sum(edf))) if penalty is None else float(penalty)
     budget = max(1, factors.size - 2)  # never more parameters than the levels support
 
@@ -351,6 +362,9 @@ def fit_sensor_model(factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, *
         terms = chosen if unchanged else problem.refine(problem.regrid(chosen)[0])[0]
         if unchanged:
             break
+    if n_samples is not None:  # the long taus: RW, long AR1 or FN, by their exact likelihood (long_tau.py)
+        terms = choose_long_terms(problem, terms, int(n_samples), budget, penalty, check,
+                                  tuple(k for k in LONG_KINDS if k in kinds)).terms
     if check is not None:
         terms = _repair(problem, terms, kinds, budget, check)
     terms = _ordered(terms)

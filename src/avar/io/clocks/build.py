@@ -122,13 +122,13 @@ def build_log(parsed: Parsed, path: Path, column: Any = None) -> ClockLog:
                                             f"{int(lines[i])}): stamps must increase"
                                             f"{f' ({back.size} such steps)' if back.size > 1 else ''}")
     times = seconds - seconds[0]
-    median, gaps = find_gaps(times)
+    found = find_gaps(times)
     why = "the default" if column is None else "asked for"
     units = unit if divisor == 1.0 else f"{unit}, read as {'s' if data_type == 'phase' else 'a fraction'}"
     frame = parsed.frame.set_axis(pd.Index(times, name="time (s)"), axis=0)
     return ClockLog(times=times, values=raw / divisor, data_type=data_type,
-                    column=f"{parsed.source}: {name} ({units}), {meaning} ({why})", rate=1.0 / median, gaps=gaps,
-                    source=parsed.source, columns=frame, path=str(path), start=parsed.start,
+                    column=f"{parsed.source}: {name} ({units}), {meaning} ({why})", rate=1.0 / found.median_step,
+                    gaps=found.gaps, source=parsed.source, columns=frame, path=str(path), start=parsed.start,
                     selected=parsed.selected, available=dict(parsed.available), skipped=dict(parsed.skipped),
                     lines=lines)
 

@@ -166,7 +166,7 @@ def read_chrony(text: Text, kind: str, source: Any = None) -> Parsed:
     keys = table.cells["IP Address"].to_numpy()
     if kind == "chrony-tracking":
         mask = np.ones(len(keys), dtype=bool)
-        references = pick_source(keys, None, "reference", text.path)[2]
+        references = pick_source(keys, None, "reference", text.path).available
         selected = "the system clock (its references: " + ", ".join(f"{k} in {n} updates" for k, n in
                                                                     references.items()) + ")"
         available: dict[str, int] = {}

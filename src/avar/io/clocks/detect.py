@@ -64,8 +64,8 @@ def detect(text: Text) -> str:
     lines = text.lines
     head = [line for line in lines[:200] if line.strip()]
     if head and (version := rinex.version_of(head[0])) is not None:
-        if version[1] != "C":
-            raise fail(text.path, 1, f"is a RINEX file of type {version[1]!r}, not clock data (type C)")
+        if version.file_type != "C":
+            raise fail(text.path, 1, f"is a RINEX file of type {version.file_type!r}, not clock data (type C)")
         return "rinex-clock"
     for line in head[:50]:
         if (kind := chrony.kind_of_header(line)) is not None:

@@ -13,12 +13,11 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from avar._frozen import frozen_array, frozen_frame, frozen_mapping
+from avar._time_steps import GAP_FACTOR
 
 if TYPE_CHECKING:  # pandas loads with the reader
     import pandas as pd
 
-#: A step longer than this many median steps is a gap (as for every log avar reads).
-GAP_FACTOR = 1.5
 #: How far (in median steps) a step may be from a whole number of steps and still sit on the grid.
 GRID_TOLERANCE = 0.25
 
@@ -45,17 +44,26 @@ class Gaps(NamedTuple):
     lengths: np.ndarray
 
 
-def find_gaps(times: np.ndarray) -> tuple[float, Gaps]:
-    """The median step (s) of increasing ``times`` (s) and the :class:`Gaps` among the steps.
+class StepsAndGaps(NamedTuple):
+    """The median time step of a clock log and its :class:`Gaps` (:func:`find_gaps`)."""
 
-    >>> step, gaps = find_gaps(np.array([0.0, 64, 128, 256, 320]))
-    >>> step, gaps.count, gaps.positions.tolist(), gaps.lengths.tolist()
+    #: The median step (s).
+    median_step: float
+    gaps: Gaps
+
+
+def find_gaps(times: np.ndarray) -> StepsAndGaps:
+    """The median step (s) of increasing ``times`` (s) and the :class:`Gaps` among the steps
+    (steps longer than :data:`avar._time_steps.GAP_FACTOR` median steps).
+
+    >>> found = find_gaps(np.array([0.0, 64, 128, 256, 320]))
+    >>> found.median_step, found.gaps.count, found.gaps.positions.tolist(), found.gaps.lengths.tolist()
     (64.0, 1, [2], [128.0])
     """
     steps = np.diff(times)
     median = float(np.median(steps))
     where = np.flatnonzero(steps > GAP_FACTOR * median)
-    return median, Gaps(int(where.size), frozen_array(where, np.int64), frozen_array(steps[where]))
+    return StepsAndGaps(median, Gaps(int(where.size), frozen_array(where, np.int64), frozen_array(steps[where])))
 
 
 def grid_positions(times: np.ndarray, step: float) -> np.ndarray | None:

@@ -20,7 +20,7 @@ records) and all are listed; ``CR``, ``DR`` and ``MS`` records are counted and s
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -41,16 +41,23 @@ FIELDS = {
 TYPES = {"AR": "station", "AS": "satellite", "CR": "calibration", "DR": "discontinuity", "MS": "monitor"}
 
 
-def version_of(line: str) -> tuple[str, str] | None:
-    """The version and file type of a ``RINEX VERSION / TYPE`` line, or None for another line.
+class Version(NamedTuple):
+    """What a RINEX file's first line says: its format version and file type (``"C"``: clock data)."""
+
+    version: str
+    file_type: str
+
+
+def version_of(line: str) -> Version | None:
+    """The :class:`Version` of a ``RINEX VERSION / TYPE`` line, or None for another line.
 
     >>> version_of("     3.04           C                   G                        RINEX VERSION / TYPE")
-    ('3.04', 'C')
+    Version(version='3.04', file_type='C')
     """
     if "RINEX VERSION / TYPE" not in line:
         return None
     fields = line.split()
-    return (fields[0], fields[1][:1]) if len(fields) >= 2 else None
+    return Version(fields[0], fields[1][:1]) if len(fields) >= 2 else None
 
 
 def _header_end(text: Text) -> int:
@@ -97,7 +104,7 @@ def read_rinex(text: Text, satellite: Any = None, station: Any = None) -> Parsed
     ([0.0, 30.0], 'satellite G01 (the only clock)')
     """
     head = version_of(text.lines[0]) if text.lines else None
-    if head is None or head[1] != "C":
+    if head is None or head.file_type != "C":
         raise fail(text.path, 1, "is not a RINEX clock file (its first line is no 'RINEX VERSION / TYPE' of type C)")
     end = _header_end(text)
     body = np.arange(end + 1, len(text.lines))
@@ -137,5 +144,5 @@ def read_rinex(text: Text, satellite: Any = None, station: Any = None) -> Parsed
                "bias sigma": np.where(counts >= 2, numbers(table, "bias sigma", text.path, optional=True), np.nan),
                **{name: more[:, k] for k, name in enumerate(CONTINUATION)}}
     start = pd.Timestamp(epochs.iloc[0]) + pd.Timedelta(seconds=float(stamp["second"][0]))
-    return Parsed(f"RINEX clock {head[0]}", numeric_frame(columns), FIELDS, "clock bias", seconds, table.lines,
+    return Parsed(f"RINEX clock {head.version}", numeric_frame(columns), FIELDS, "clock bias", seconds, table.lines,
                   start=start, selected=selected, available=available, skipped=skipped)

@@ -181,21 +181,30 @@ def numbers(table: Table, name: str, path: Path, optional: bool = False) -> np.n
     return values
 
 
-def pick_source(keys: np.ndarray, wanted: Any, what: str, path: Path,
-                argument: str = "source") -> tuple[np.ndarray, str, dict[str, int]]:
-    """The rows of one source among ``keys`` (a source per row), its name and every source's count.
+class Source(NamedTuple):
+    """One source of a file that interleaves several (:func:`pick_source`)."""
+
+    #: The rows of the source taken (bool, one per row).
+    rows: np.ndarray
+    #: ``"203.0.113.15 (the most frequent of 2 sources: 6 of 9 records)"`` or ``"... (asked for ...)"``.
+    selected: str
+    #: Each source's row count, in order of first appearance.
+    available: dict[str, int]
+
+
+def pick_source(keys: np.ndarray, wanted: Any, what: str, path: Path, argument: str = "source") -> Source:
+    """The :class:`Source`: the rows of one source among ``keys`` (a source per row), its name and
+    every source's count.
 
     ``wanted`` is a source's name (or a word of it, when that names one source only); None takes
     the source with the most rows (the first in the file on a tie).
 
-    Returns
-    -------
-    rows : ndarray of bool
-        The rows of the source taken.
-    selected : str
-        ``"203.0.113.15 (the most frequent of 2 sources: 6 of 9 records)"`` or ``"... (asked for)"``.
-    available : dict
-        Each source's row count, in order of first appearance.
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> source = pick_source(np.array(["a", "b", "b"]), None, "peer", Path("peers.log"))
+    >>> source.rows.tolist(), source.selected, source.available
+    ([False, True, True], 'b (the most frequent of 2 peers: 2 of 3 records; others: a)', {'a': 1, 'b': 2})
     """
     codes, names = pd.factorize(pd.Series(keys, dtype=object))  # in order of first appearance
     available = {str(name): int(count) for name, count in zip(names, np.bincount(codes, minlength=len(names)))}
@@ -217,4 +226,4 @@ def pick_source(keys: np.ndarray, wanted: Any, what: str, path: Path,
         name = matches[0]
         reason = f"asked for: {available[name]} of {len(keys)} records" + (
             f"; others: {', '.join(k for k in available if k != name)}" if len(available) > 1 else "")
-    return codes == list(available).index(name), f"{name} ({reason})", available
+    return Source(codes == list(available).index(name), f"{name} ({reason})", available)

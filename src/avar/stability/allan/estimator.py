@@ -23,7 +23,7 @@ from avar._validation import (
 )
 from avar.imu import IMU
 from avar.stability.allan.columns import allan_variance_columns
-from avar.stability.allan.intervals import check_ci, chi2_band, relative_errors
+from avar.stability.allan.intervals import R_BAND, IntervalChoice, check_ci, chi2_band, relative_errors
 from avar.stability.allan.results import AllanVariance, ImuAllanVariance
 from avar.stability.shared.grids import averaging_factors, check_type
 from avar.stability.shared.term_counts import n_differences
@@ -141,7 +141,7 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
 
         gappy = series_with_gaps(x, freq) if check_nan_policy(nan_policy) and not isinstance(x, IMU) else None
         if gappy is not None:
-            return allan_variance_with_gaps(*gappy, kind, taus, band)
+            return allan_variance_with_gaps(gappy.values, gappy.rate, kind, taus, band)
     if isinstance(x, IMU):
         if freq is not None:
             raise ValueError("an IMU carries its own freq; do not pass freq with an IMU")
@@ -164,12 +164,12 @@ def avar(x: Any, type: str = "mo", freq: float | None = None, taus: Any = "octav
             axes=x.axes,
             units=x.units,
         )
-    values, rate = as_series(x, freq, native=True)
-    return allan_variance_table(values[:, None], (None,), rate, kind, taus, band)[None]
+    series = as_series(x, freq, native=True)
+    return allan_variance_table(series.values[:, None], (None,), series.rate, kind, taus, band)[None]
 
 
 def allan_variance_table(
-    data: np.ndarray, names: tuple, freq: float, type: str, taus: Any, band: tuple = ("r", None),
+    data: np.ndarray, names: tuple, freq: float, type: str, taus: Any, band: IntervalChoice = R_BAND,
     columns: Any = None,
 ) -> dict[Any, AllanVariance]:
     """Allan variance of every column of a validated (N, C) table, keyed by column name.
@@ -177,7 +177,8 @@ def allan_variance_table(
     The one estimation path: a series is a table of one column, an IMU a table
     of its channels, and every column shares the tau grid and one pass of the
     kernels; each column's result equals that of the column alone. ``band``
-    is (ci, confidence): with "chi2" each column also gets its chi-squared band.
+    (:class:`~avar.stability.allan.intervals.IntervalChoice`): with ``ci="chi2"`` each column also
+    gets its chi-squared band.
     ``columns`` computes the (C, L) Allan variances (default the kernels; the Dask backend for Dask arrays).
     """
     n = data.shape[0]
@@ -186,13 +187,13 @@ def allan_variance_table(
     levels = factors / freq
     errors = relative_errors(n, factors)
     counts = n_differences(n, factors, type)
-    ci, confidence = band
     results = {}
     for j, name in enumerate(names):
         extra: dict[str, Any] = {}
-        if ci == "chi2":
-            alpha, edf, lci, uci = chi2_band(data[:, j], factors, freq, type, allan[j], confidence)
-            extra = dict(ci=ci, confidence=confidence, alpha=alpha, edf=edf, chi2_lci=lci, chi2_uci=uci)
+        if band.ci == "chi2":
+            chi2 = chi2_band(data[:, j], factors, freq, type, allan[j], band.confidence)
+            extra = dict(ci=band.ci, confidence=band.confidence, alpha=chi2.alpha, edf=chi2.edf,
+                         chi2_lci=chi2.lci, chi2_uci=chi2.uci)
         results[name] = AllanVariance(levels=levels, averaging_factors=factors, allan=allan[j], errors=errors,
                                       n_differences=counts, type=type, freq=freq, n=n, name=name, **extra)
     return results
@@ -203,7 +204,8 @@ def _is_dask_array(x: Any) -> bool:
     return dask_array is not None and isinstance(x, dask_array.Array)
 
 
-def _dask_allan_variance(x: Any, freq: Any, type: str, taus: Any, band: tuple, nan_policy: str) -> AllanVariance:
+def _dask_allan_variance(x: Any, freq: Any, type: str, taus: Any, band: IntervalChoice,
+                         nan_policy: str) -> AllanVariance:
     """A 1-D Dask array: computed into memory and handed to the NumPy path when it fits
     (:func:`avar.stability.allan.dask.fits_in_memory`), else chunk by chunk on the active
     scheduler with chunks of at least :data:`~avar.stability.allan.dask.MIN_CHUNK` samples
@@ -215,9 +217,9 @@ def _dask_allan_variance(x: Any, freq: Any, type: str, taus: Any, band: tuple, n
     check_numeric_dtype(np.empty(0, dtype=x.dtype), "x")
     x = known_chunks(x)
     if fits_in_memory(x):
-        return avar(np.asarray(x.compute()), type=type, freq=freq, taus=taus, ci=band[0], confidence=band[1],
+        return avar(np.asarray(x.compute()), type=type, freq=freq, taus=taus, ci=band.ci, confidence=band.confidence,
                     nan_policy=nan_policy)
-    if band[0] != "r" or nan_policy != "raise":
+    if band.ci != "r" or nan_policy != "raise":
         raise ValueError("a Dask array larger than memory takes ci='r' and nan_policy='raise' (noise "
                          "identification and gaps need the series in memory)")
     check_length(int(x.shape[0]), "x")

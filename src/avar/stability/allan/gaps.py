@@ -10,12 +10,12 @@ taken as frequency data, and "to" is ADEV**2, both from
 from __future__ import annotations
 
 import sys
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from avar._validation import as_series, short_repr
-from avar.stability.allan.intervals import relative_errors
+from avar.stability.allan.intervals import R_BAND, IntervalChoice, relative_errors
 from avar.stability.allan.results import AllanVariance
 from avar.stability.classic.core import deviation_levels
 from avar.stability.classic.deviations import noise_exponents
@@ -34,8 +34,18 @@ def check_nan_policy(nan_policy: Any) -> bool:
     return nan_policy == "omit"
 
 
-def series_with_gaps(x: Any, freq: Any) -> tuple[np.ndarray, float] | None:
-    """Float64 values (NaN kept) and rate of a 1-D series holding NaN; None when it holds none.
+class GappySeries(NamedTuple):
+    """A 1-D series holding NaN (:func:`series_with_gaps`)."""
+
+    #: float64 samples, NaN where a value is missing.
+    values: np.ndarray
+    #: Sampling rate (Hz).
+    rate: float
+
+
+def series_with_gaps(x: Any, freq: Any) -> GappySeries | None:
+    """The :class:`GappySeries` of float64 values (NaN kept) and rate of a 1-D series holding NaN;
+    None when it holds none.
 
     Everything but the NaN is validated by :func:`avar._validation.as_series`.
     """
@@ -54,35 +64,35 @@ def series_with_gaps(x: Any, freq: Any) -> tuple[np.ndarray, float] | None:
     if missing.all():
         raise ValueError("x holds only NaN values")
     filled = x.fillna(0.0) if series else np.where(missing, 0.0, array)
-    values, rate = as_series(filled, freq)
-    values = np.array(values, dtype=np.float64)
+    checked = as_series(filled, freq)
+    values = np.array(checked.values, dtype=np.float64)
     values[missing] = np.nan
-    return values, rate
+    return GappySeries(values, checked.rate)
 
 
 def allan_variance_with_gaps(values: np.ndarray, freq: float, type: str, taus: Any,
-                             band: tuple = ("r", None)) -> AllanVariance:
+                             band: IntervalChoice = R_BAND) -> AllanVariance:
     """Allan variance of a series with NaN gaps, skipping the differences that touch one.
 
-    Levels left without a difference are dropped. With ``band = ("chi2",
-    confidence)`` the noise is identified on the longest gap-free stretch and
-    the EDF is scaled by the fraction of differences used.
+    Levels left without a difference are dropped. With ``band.ci == "chi2"`` (an
+    :class:`~avar.stability.allan.intervals.IntervalChoice`) the noise is identified on the
+    longest gap-free stretch and the EDF is scaled by the fraction of differences used.
     """
     n = values.shape[0]
     factors = averaging_factors(n, freq, taus)
     estimator = TYPE_ESTIMATORS[type]
-    allan, counts = deviation_levels(estimator, values, factors, "freq", freq)
+    levels = deviation_levels(estimator, values, factors, "freq", freq)
+    allan, counts = levels.variance, levels.n_terms
     keep = counts > 0
     if not keep.any():
         raise ValueError("no difference of cluster means avoids the NaN values of x at these taus")
     factors, allan, counts = factors[keep], allan[keep], counts[keep]
     extra: dict[str, Any] = {}
-    ci, confidence = band
-    if ci == "chi2":
+    if band.ci == "chi2":
         alpha = noise_exponents(estimator, values, "freq", freq, factors)
         edf = gap_scaled_edf(estimator_edf(estimator, alpha, factors, n + 1), counts, estimator, n + 1, factors)
-        lci, uci = chi2_bounds(np.sqrt(allan), edf, confidence)
-        extra = dict(ci=ci, confidence=confidence, alpha=alpha, edf=edf, chi2_lci=lci, chi2_uci=uci)
+        lci, uci = chi2_bounds(np.sqrt(allan), edf, band.confidence)
+        extra = dict(ci=band.ci, confidence=band.confidence, alpha=alpha, edf=edf, chi2_lci=lci, chi2_uci=uci)
     return AllanVariance(levels=factors / freq, averaging_factors=factors, allan=allan,
                          errors=relative_errors(n, factors), n_differences=counts, type=type, freq=freq, n=n,
                          name=None, **extra)

@@ -20,25 +20,39 @@ def relative_errors(n: int, factors: np.ndarray) -> np.ndarray:
     return 1.0 / np.sqrt(2.0 * (n / np.asarray(factors, dtype=np.float64) - 1.0))
 
 
-def check_ci(ci: Any, confidence: Any) -> tuple[str, float | None]:
+class IntervalChoice(NamedTuple):
+    """The interval ``avar()`` was asked for: ``ci`` ("r" or "chi2") and its ``confidence``.
+
+    ``confidence`` is None for R's band (fixed at adev (1 -/+ 2 errors)).
+    """
+
+    ci: str
+    confidence: float | None
+
+
+#: R's band, the default of ``avar()``.
+R_BAND = IntervalChoice("r", None)
+
+
+def check_ci(ci: Any, confidence: Any) -> IntervalChoice:
     """Validate ``avar()``'s ``ci`` and ``confidence``; the confidence defaults to one sigma for "chi2".
 
-    >>> (ci, level), r_band = check_ci("chi2", None), check_ci("r", None)
-    >>> ci, round(level, 4), r_band
-    ('chi2', 0.6827, ('r', None))
+    >>> chi2, r_band = check_ci("chi2", None), check_ci("r", None)
+    >>> chi2.ci, round(chi2.confidence, 4), r_band
+    ('chi2', 0.6827, IntervalChoice(ci='r', confidence=None))
     """
     if not isinstance(ci, str) or ci.lower() not in CI_KINDS:
         raise ValueError(f"ci must be 'r' (R's band adev (1 -/+ 2 errors)) or 'chi2' (chi-squared band "
                          f"from Greenhall's EDF), got {short_repr(ci)}")
     ci = ci.lower()
     if confidence is None:
-        return ci, (DEFAULT_CONFIDENCE if ci == "chi2" else None)
+        return IntervalChoice(ci, DEFAULT_CONFIDENCE if ci == "chi2" else None)
     if ci == "r":
         raise ValueError("confidence applies to ci='chi2' only (R's band is fixed at adev (1 -/+ 2 errors))")
     if isinstance(confidence, (bool, np.bool_)) or not isinstance(confidence, (int, float, np.integer, np.floating)) \
             or not 0 < confidence < 1:
         raise ValueError(f"confidence must be a number in (0, 1), e.g. 0.683 or 0.95, got {short_repr(confidence)}")
-    return ci, float(confidence)
+    return IntervalChoice(ci, float(confidence))
 
 
 class Chi2Band(NamedTuple):

@@ -101,6 +101,13 @@ class PhaseParts(NamedTuple):
     line: float | None
 
 
+class DeviationLevels(NamedTuple):
+    """Variances and term counts of every level (:func:`deviation_levels`)."""
+
+    variance: np.ndarray
+    n_terms: np.ndarray
+
+
 class LevelsAndPhase(NamedTuple):
     """Variances and term counts of every level, and what the noise identification needs
     (:func:`deviation_levels_and_phase`)."""
@@ -223,7 +230,7 @@ def phase_parts(data: np.ndarray, data_type: str, estimator: str, scanned: tuple
 
 def deviation_levels(
     estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str = "phase", rate: float = 1.0
-) -> tuple[np.ndarray, np.ndarray]:
+) -> DeviationLevels:
     """Variance and number of terms of one estimator at every averaging factor.
 
     Parameters
@@ -240,22 +247,21 @@ def deviation_levels(
 
     Returns
     -------
-    variance : float64 ndarray
-        The estimator's variance (TDEV: s^2; the others dimensionless), NaN
-        where no term is left.
-    n : int64 ndarray
-        Terms averaged at every level.
+    DeviationLevels
+        ``variance`` (float64 ndarray): the estimator's variance (TDEV: s^2; the others
+        dimensionless), NaN where no term is left; ``n_terms`` (int64 ndarray): terms
+        averaged at every level.
 
     Examples
     --------
     >>> import numpy as np
     >>> y = np.array([0.0, 1.0, 0.0, 1.0, 0.0])
-    >>> variance, n = deviation_levels("oadev", y, np.array([1, 2]), data_type="freq")
-    >>> variance.tolist(), n.tolist()
+    >>> levels = deviation_levels("oadev", y, np.array([1, 2]), data_type="freq")
+    >>> levels.variance.tolist(), levels.n_terms.tolist()
     ([0.5, 0.0], [4, 2])
     """
     levels = deviation_levels_and_phase(estimator, data, factors, data_type, rate)
-    return levels.variance, levels.n_terms
+    return DeviationLevels(levels.variance, levels.n_terms)
 
 
 def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str = "phase",

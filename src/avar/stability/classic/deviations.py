@@ -100,8 +100,8 @@ def _estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, c
     factors = deviation_factors(estimator, n_phase, rate, taus)
     values, scanned, exponent = scaled(values, scanned, drift_removed)
     variance, n, phase, drift, line = deviation_levels_and_phase(estimator, values, factors, data_type, rate, scanned)
-    n, variance, factors = levels_with_terms(estimator, n, (variance, factors),
-                                             f"the {n_missing} NaN value(s) of data" if n_missing else None)
+    n, variance, factors, _ = levels_with_terms(estimator, n, variance, factors,
+                                                f"the {n_missing} NaN value(s) of data" if n_missing else None)
     deviation = np.ldexp(np.sqrt(variance), exponent)
     if exponent:
         with np.errstate(over="ignore", under="ignore"):

@@ -239,15 +239,6 @@ def dadev(data: Any, rate: float | None = None, data_type: str = "freq", window:
 
     Each window's row equals ``avar.oadev`` of its samples; taus up to a quarter of the window.
     {parameters}
-    Returns
-    -------
-    DynamicDeviation
-
-    References
-    ----------
-    L. Galleani and P. Tavella, "The dynamic Allan variance", IEEE Trans. UFFC 56, 2009.
-    W. J. Riley, Stable32 User Manual (Dynamic stability), 2008.
-
     Examples
     --------
     >>> import numpy as np
@@ -267,15 +258,6 @@ def dhdev(data: Any, rate: float | None = None, data_type: str = "freq", window:
     Each window's row equals ``avar.ohdev`` of its samples (blind to each window's linear
     frequency drift); taus up to a quarter of the window.
     {parameters}
-    Returns
-    -------
-    DynamicDeviation
-
-    References
-    ----------
-    L. Galleani and P. Tavella, "The dynamic Allan variance", IEEE Trans. UFFC 56, 2009.
-    W. J. Riley, Stable32 User Manual (Dynamic stability), 2008.
-
     Examples
     --------
     >>> import numpy as np
@@ -289,6 +271,19 @@ def dhdev(data: Any, rate: float | None = None, data_type: str = "freq", window:
     return dynamic("ohdev", data, rate, data_type, window, step, taus, confidence, nan_policy)
 
 
+#: What :func:`dadev` and :func:`dhdev` return, and where the statistic comes from.
+_RETURNS_AND_REFERENCES = """    Returns
+    -------
+    DynamicDeviation
+        As :func:`dynamic`.
+
+    References
+    ----------
+    L. Galleani and P. Tavella, "The dynamic Allan variance", IEEE Trans. UFFC 56, 2009.
+    W. J. Riley, Stable32 User Manual (Dynamic stability), 2008.
+
+"""
+
 _WINDOW_PARAMETERS = """    window : int, optional
         Samples per window (frequency values or phase points, as ``data``); default a tenth of
         the record (at least 4). The taus reach a quarter of it.
@@ -297,12 +292,12 @@ _WINDOW_PARAMETERS = """    window : int, optional
 """
 
 
-def _fill(function: Any, first: str = "") -> None:
+def _fill(function: Any, first: str = "", after: str = "") -> None:
     """Put the family's parameters (``first`` before ``data``; ``window`` and ``step`` before
-    ``taus``; no ``Returns``) in the docstring."""
+    ``taus``; no ``Returns``), then ``after``, in the docstring."""
     parameters = PARAMETERS.split("\n\n    Returns")[0]
     data, taus = parameters.index("    data :"), parameters.index("    taus :")
-    text = parameters[:data] + first + parameters[data:taus] + _WINDOW_PARAMETERS + parameters[taus:] + "\n\n"
+    text = parameters[:data] + first + parameters[data:taus] + _WINDOW_PARAMETERS + parameters[taus:] + "\n\n" + after
     function.__doc__ = function.__doc__.replace("    {parameters}\n", text)
 
 
@@ -310,5 +305,5 @@ _fill(dynamic, """    statistic : str
         One of the classic family (:data:`DYNAMIC_STATISTICS`): ``"adev"``, ``"oadev"``, ``"mdev"``,
         ``"tdev"``, ``"hdev"``, ``"ohdev"``, ``"totdev"``, ``"mhdev"``, ``"htdev"``.
 """)
-_fill(dadev)
-_fill(dhdev)
+_fill(dadev, after=_RETURNS_AND_REFERENCES)
+_fill(dhdev, after=_RETURNS_AND_REFERENCES)

@@ -14,7 +14,8 @@ import numpy as np
 import pandas as pd
 
 from avar._kernels.classic.phase import scan
-from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, rate_from_index, short_repr
+from avar._time_steps import rate_from_index
+from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, short_repr
 from avar.stability.shared.confidence import DEFAULT_CONFIDENCE
 
 __all__ = ["DATA_TYPES", "DEFAULT_CONFIDENCE", "NAN_POLICIES", "SCALE_LIMIT", "TINY_LIMIT", "check_data", "check_not_tiny",

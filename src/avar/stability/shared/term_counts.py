@@ -110,21 +110,36 @@ def term_ranges(estimator: str, n_phase: int, factors: np.ndarray) -> TermRanges
     return TermRanges(strides, first, first + counts)
 
 
-def levels_with_terms(statistic: str, n: np.ndarray, arrays: tuple, missing: str | None) -> tuple:
-    """``(n, *arrays)`` cut to the levels with at least one term, the first array the variances.
+class KeptLevels(NamedTuple):
+    """The levels left with at least one term (:func:`levels_with_terms`)."""
+
+    n_terms: np.ndarray
+    variance: np.ndarray
+    factors: np.ndarray
+    #: The deviation of every level kept, when one was given (else None).
+    deviation: np.ndarray | None = None
+
+
+def levels_with_terms(statistic: str, n_terms: np.ndarray, variance: np.ndarray, factors: np.ndarray,
+                      missing: str | None, deviation: np.ndarray | None = None) -> KeptLevels:
+    """The :class:`KeptLevels`: terms, variances, factors (and ``deviation``, if given) of the
+    levels with at least one term.
 
     ``missing`` names the data's NaN values when there are any (only then can a
     level lose every term): no level left is an error naming them. Variances
     that overflowed are an error too.
 
-    >>> levels_with_terms("adev", np.array([3, 0]), (np.array([1.0, 2.0]),), "the 1 NaN value(s) of data")
-    (array([3]), array([1.]))
+    >>> kept = levels_with_terms("adev", np.array([3, 0]), np.array([1.0, 2.0]), np.array([1, 2]),
+    ...                          "the 1 NaN value(s) of data")
+    >>> kept.n_terms.tolist(), kept.variance.tolist(), kept.factors.tolist(), kept.deviation
+    ([3], [1.0], [1], None)
     """
     if missing is not None:
-        keep = n > 0
+        keep = n_terms > 0
         if not keep.any():
             raise ValueError(f"no {statistic} term avoids {missing} at these taus")
-        n, arrays = n[keep], tuple(a[keep] for a in arrays)
-    if not np.all(np.isfinite(arrays[0])):
+        n_terms, variance, factors = n_terms[keep], variance[keep], factors[keep]
+        deviation = None if deviation is None else deviation[keep]
+    if not np.all(np.isfinite(variance)):
         raise ValueError(f"{statistic} overflows float64; rescale the data, e.g. to other units")
-    return (n, *arrays)
+    return KeptLevels(n_terms, variance, factors, deviation)

@@ -91,8 +91,8 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         if statistic == "pdev":
             variance = variance / (m / rate) ** 2
         deviation = np.sqrt(variance)
-    n, variance, factors, deviation = levels_with_terms(statistic, n, (variance, factors, deviation),
-                                                        f"the {int(gaps[-1])} NaN value(s) of data")
+    n, variance, factors, deviation = levels_with_terms(statistic, n, variance, factors,
+                                                        f"the {int(gaps[-1])} NaN value(s) of data", deviation)
     alpha_levels = level_noise(fixed, values, phase, gaps, data_type, rate, factors)
     if statistic == "pdev":
         edf = pdev_edf(alpha_levels, factors, n_phase)

@@ -37,7 +37,7 @@ import numpy as np
 from avar._frozen import frozen_array
 from avar._validation import short_repr
 
-__all__ = ["MASKS", "Mask", "MaskCheck", "MaskPiece", "mask_check"]
+__all__ = ["MASKS", "Mask", "MaskCheck", "MaskPiece", "find_mask", "mask_check"]
 
 _NS = 1e-9
 _US = 1e-6
@@ -138,6 +138,29 @@ _ALL = (
 
 #: Every mask by name (constant temperature wander generation).
 MASKS = MappingProxyType({mask.name: mask for mask in _ALL})
+
+
+def find_mask(mask: Any, statistic: str) -> Mask:
+    """The :class:`Mask` ``mask`` names for ``statistic`` (``"mtie"`` or ``"tdev"``).
+
+    ``mask`` is a :class:`Mask`, a name of :data:`MASKS`, or a clock's name without the
+    statistic (``"G.8262 EEC option 1"``): the mask of that clock for ``statistic``.
+
+    >>> find_mask("G.8262 EEC option 1", "tdev").name
+    'G.8262 EEC option 1 TDEV'
+    """
+    if isinstance(mask, str):
+        name = mask if mask in MASKS else f"{mask} {str(statistic).upper()}"
+        if name not in MASKS:
+            clocks = sorted({known.rsplit(" ", 1)[0] for known in MASKS})
+            raise ValueError(f"mask: unknown mask {short_repr(mask)} for {str(statistic).upper()}; known clocks: "
+                             f"{', '.join(clocks)} (or a full name of avar.MASKS)")
+        mask = MASKS[name]
+    if not isinstance(mask, Mask):
+        raise TypeError(f"mask must be a name of avar.MASKS or a Mask, got {type(mask).__name__}")
+    if mask.statistic != statistic:
+        raise ValueError(f"mask {mask.name!r} limits {mask.statistic.upper()}, not {str(statistic).upper()}")
+    return mask
 
 
 @dataclass(frozen=True, eq=False)

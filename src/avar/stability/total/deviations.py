@@ -13,7 +13,7 @@ bias from :mod:`avar.stability.uncertainty.total_edf`.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -75,10 +75,28 @@ def _check_bias(bias_correction: Any, estimator: str) -> bool | str | None:
     return bool(bias_correction)
 
 
-def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confidence: Any, nan_policy: Any):
-    """Validate once: ``values, rate, x, bad, shift, scale, n_phase``; ``x`` the detrended phase
-    (scaled by ``scale``, a power of two; HTOTDEV: its linear frequency drift removed too, as
-    every statistic here is blind to it) with gaps filled, ``bad`` their prefix count."""
+class PreparedPhase(NamedTuple):
+    """The validated data of a total deviation and the phase its kernels read (:func:`prepared_phase`)."""
+
+    #: The data as validated (phase, s, or fractional frequency).
+    values: np.ndarray
+    #: Sampling rate (Hz).
+    rate: float
+    #: The detrended phase, scaled by ``scale`` (a power of two), gaps filled (contiguous float64).
+    phase: np.ndarray
+    #: The prefix count of the gaps (int64; empty without gaps), as the kernels take it.
+    bad: np.ndarray
+    #: 1 for frequency data (the phase has one point more than the data), else 0.
+    shift: int
+    scale: float
+    n_phase: int
+
+
+def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confidence: Any,
+                   nan_policy: Any) -> PreparedPhase:
+    """Validate once: the :class:`PreparedPhase`; its ``phase`` is the detrended phase (scaled by
+    ``scale``, a power of two; HTOTDEV: its linear frequency drift removed too, as every statistic
+    here is blind to it) with gaps filled, ``bad`` their prefix count."""
     rate = check_options(estimator, data, rate, data_type, confidence, nan_policy)
     values, scanned = check_data(data, data_type, nan_policy, statistic=estimator)
     check_not_tiny(estimator, scanned)
@@ -87,7 +105,8 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
     x, _, scale, _, bad, *_ = phase_parts(values, data_type, "ohdev" if estimator == "htotdev" else "oadev", scanned)
     bad = np.zeros(0, dtype=np.int64) if bad is None else np.ascontiguousarray(bad, dtype=np.int64)
-    return values, rate, np.ascontiguousarray(x), bad, int(data_type == "freq"), scale, values.size + (data_type == "freq")
+    return PreparedPhase(values, rate, np.ascontiguousarray(x), bad, int(data_type == "freq"), scale,
+                         values.size + (data_type == "freq"))
 
 
 def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int,
@@ -96,7 +115,7 @@ def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.nd
     """Unbiased-as-defined variances and term counts (NaN where no term is left); ``autocorr``:
     the FFT autocorrelation of gap-free ``x`` for Theo1, if at hand."""
     if estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
-        sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift)[0], autocorr)[0]
+        sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift).total, autocorr).sums
         counts = x.shape[0] - factors
     else:  # HTOTDEV's m = 1 is OHDEV (below): its level is not summed
         first = int(estimator == "htotdev" and factors.size > 0 and factors[0] == 1)
@@ -145,8 +164,8 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
     # Theo1 scaled by kf: one FFT autocorrelation of the record serves both
     autocorr = autocorrelation(x) if bias == "theobr" and bad.size == 0 else None
     variance, n = raw_variances(estimator, x, factors, bad, shift, scale, rate, data_type == "phase", autocorr)
-    n, variance, factors = levels_with_terms(estimator, n, (variance, factors),
-                                             "the NaN values of data" if bad.size else None)
+    n, variance, factors, _ = levels_with_terms(estimator, n, variance, factors,
+                                                "the NaN values of data" if bad.size else None)
     if alpha is None:
         noise_factors = np.maximum(1, np.round(0.75 * factors)).astype(np.int64) if estimator == "theo1" else factors
         alphas = noise_exponents(_NOISE_RULES[estimator], values, data_type, rate, noise_factors)
@@ -157,7 +176,7 @@ def estimate(estimator: str, data: Any, rate: Any, data_type: Any, taus: Any, co
             raise ValueError(f"theo1's TheoBR bias factor needs gap-free data of at least {MIN_THEOBR_POINTS} phase "
                              f"points (got {n_phase}{' with NaN' if bad.size else ''}); pass bias_correction=False "
                              "for the raw statistic or True for the fixed noise's correction")
-        variance = variance * theobr_factor(x, autocorr)[0]
+        variance = variance * theobr_factor(x, autocorr).kf
     elif bias:
         variance = correct_bias(estimator, variance, alphas, factors)
     tau = (0.75 * factors if estimator == "theo1" else factors) / rate

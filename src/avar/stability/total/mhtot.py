@@ -85,8 +85,8 @@ def mhtotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus
         if data_type == "phase":
             variance = variance * rate * rate
     variance[counts == 0] = np.nan
-    n, variance, factors = levels_with_terms("mhtotdev", counts, (variance, factors),
-                                             "the NaN values of data" if bad.size else None)
+    n, variance, factors, _ = levels_with_terms("mhtotdev", counts, variance, factors,
+                                                "the NaN values of data" if bad.size else None)
     if fixed is None:
         alphas = noise_exponents(REFERENCE, values, data_type, rate, factors)
     else:

@@ -84,23 +84,25 @@ def theobr_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[np.
     diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), int(m_avar[-1]) + 1)
     avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
     avar_norm = 2.0 * m_avar * m_avar * (n_points - 2 * m_avar)
-    every, ratio = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
+    every = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
     theo_norm = 0.75 * (n_points - m_theo) * m_theo * m_theo
-    sums, ratio = every[m_theo], ratio[m_theo]
+    sums, ratio = every.sums[m_theo], every.ratios[m_theo]
     # each of the two kinds of sums may bring half of kf's tolerance
     redo = _levels_to_redo(avar_sums / avar_norm * theo_norm / sums, avar_ratio, 0.5)
     if redo.size:  # by the split expansion, then directly
-        _take_better(avar_sums, avar_ratio, redo, *split_sums(x, np.zeros(0), KF_ALLAN_REACH, m_avar[redo])[2:])
+        again = split_sums(x, np.zeros(0), KF_ALLAN_REACH, m_avar[redo])
+        _take_better(avar_sums, avar_ratio, redo, again.allan, again.allan_ratios)
         redo = redo[np.isin(redo, _levels_to_redo(avar_sums / avar_norm * theo_norm / sums, avar_ratio, 0.5))]
         avar_sums[redo] = oavar_sums(x, m_avar[redo])
     avar = avar_sums / avar_norm
     split = _levels_to_redo(avar * theo_norm / sums, ratio, 0.5)  # first by the split expansion
     if split.size:
-        _take_better(sums, ratio, split, *split_sums(x, m_theo[split], KF_REACH)[:2])
+        again = split_sums(x, m_theo[split], KF_REACH)
+        _take_better(sums, ratio, split, again.theo1, again.theo1_ratios)
     theo = sums / theo_norm
     no_gaps = np.zeros(0, dtype=np.int64)
     for level in _levels_to_redo(avar / theo, ratio, 0.5):
-        theo[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0)[0] / theo_norm[level]
+        theo[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0).total / theo_norm[level]
     return avar / theo, n
 
 

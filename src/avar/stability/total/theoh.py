@@ -148,7 +148,7 @@ def theoh(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
     no_gaps = np.zeros(0, dtype=np.int64)
     (kf, _), sums, allan_sums = run_concurrently(  # kf and the displayed levels at the same time
         lambda: theobr_factor(x, autocorr),
-        lambda: theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0)[0], autocorr)[0],
+        lambda: theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0).total, autocorr).sums,
         lambda: oavar_sums(x, allan))
     counts = n_phase - theo
     with np.errstate(over="ignore"):  # an overflow is an error below
