@@ -274,7 +274,7 @@ def test_noise_report_takes_the_recording_and_the_imu_as_read(tmp_path):
         pd.testing.assert_frame_equal(report.table, from_recording.table)
     assert from_recording.source == str(path) and from_recording.name == str(path) and from_recording.topic == "/imu"
     assert from_imu.name == "log" and from_imu.source is None
-    assert "SimpleNamespace" not in (ROOT / "src/avar/cli/report.py").read_text()
+    assert "SimpleNamespace" not in (ROOT / "src/avar/cli/imu/report.py").read_text()
 
 
 def test_units_are_one_table_in_python():

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from avar.cli import report_many
+from avar.cli.imu import report_many
 from avar.models import RW, WN
 from tests._support.cli_runner import cli
 

@@ -17,9 +17,11 @@ import threading
 import warnings
 
 from avar._validation import cap_text
-from avar.cli import clock_report, compute, datasets, demo, deviation, fit, report, simulate, warmup
+from avar.cli import compute, datasets, demo, fit, warmup
+from avar.cli.clock import clock_report, deviation
 from avar.cli.common import InputFileError, UsageError, printable, resolve_aliases
 from avar.cli.first_run import COMPILE_SECONDS, compile_notice
+from avar.cli.imu import report, simulate
 from avar.cli.outputs import remove_pending
 
 SUBCOMMANDS = (demo, compute, deviation, fit, report, clock_report, simulate, datasets, warmup)

@@ -23,9 +23,9 @@ from avar.cli.common import (
 )
 from avar.cli.compute import FILE_HELP, add_output_arguments, add_reading_arguments
 from avar.cli.compute_many import add_cluster_arguments, check_bag_units
+from avar.cli.imu.simulate import add_recheck_arguments, print_recheck
 from avar.cli.outputs import check_output_path, csv_text, plan_outputs
 from avar.cli.outputs import report as print_outputs
-from avar.cli.simulate import add_recheck_arguments, print_recheck
 
 
 def read_recording(args: argparse.Namespace):
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
 
     axis_and_inflate(args)
     if len(args.file) > 1 or args.workers is not None or args.scheduler is not None or _is_folder(args.file[0]):
-        from avar.cli.report_many import run_many
+        from avar.cli.imu.report_many import run_many
 
         if args.export:
             raise UsageError("--export writes one log's report; with several logs, give one log per run")

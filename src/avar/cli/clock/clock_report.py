@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from avar.cli.clock.deviation import read_series
 from avar.cli.common import Progress, UsageError, add_confidence_arguments, printable, replicates, seed_number
 from avar.cli.compute import add_output_arguments, add_reading_arguments
-from avar.cli.deviation import read_series
 from avar.cli.outputs import check_output_path, csv_text, plan_outputs, report
 
 #: Columns of ``--output``: the power laws and the Kalman coefficients, one row each.

@@ -1,0 +1,1 @@
+"""The time-and-frequency subcommands: ``avar deviation`` and ``avar clock-report``."""

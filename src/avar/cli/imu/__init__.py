@@ -1,0 +1,1 @@
+"""The IMU subcommands: ``avar report`` (one log or several) and ``avar simulate``."""
