@@ -17,7 +17,7 @@ from avar.io.read import InputFileError
 __all__ = ["FLOAT_FORMAT", "InputFileError", "Progress", "UsageError", "accel_unit", "add_confidence_arguments",
            "add_rate_arguments", "add_unit_arguments", "confidence_alpha", "confidence_level", "display",
            "format_table", "gyro_unit", "parse_scales", "printable", "replicates", "resolve_aliases", "seed_number",
-           "unit_label", "variables_note"]
+           "unit_label", "variables_note", "whole_number"]
 
 FLOAT_FORMAT = "{:.6g}".format
 
@@ -232,15 +232,28 @@ def confidence_alpha(text: str) -> float:
     return _probability(text, "1 - the confidence level, a number in (0, 1) such as 0.05")
 
 
-def seed_number(text: str) -> int:
-    """``--seed``: a whole number >= 0."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {short_repr(text)}")
-    return value
+def whole_number(minimum: int, what: str = ""):
+    """An argparse ``type``: a whole number >= ``minimum``, refused with one line naming ``what`` it counts.
+
+    >>> whole_number(1, "workers")("3")
+    3
+    """
+    label = f"a whole number of {what} >= {minimum}" if what else f"a whole number >= {minimum}"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = minimum - 1
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"expected {label}, got {short_repr(text)}")
+        return value
+
+    return parse
+
+
+#: ``--seed``: a whole number >= 0.
+seed_number = whole_number(0)
 
 
 def replicates(text: str) -> int:

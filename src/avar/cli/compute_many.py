@@ -36,6 +36,7 @@ from avar.cli.common import (
     printable,
     unit_label,
     variables_note,
+    whole_number,
 )
 from avar.cli.outputs import csv_text, plan_outputs, report
 
@@ -52,15 +53,8 @@ QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 DASK_MISSING = '--workers/--scheduler run on dask.distributed, which is not installed: pip install "allanvar[dask]"'
 
 
-def positive_int(text: str) -> int:
-    """``--workers``: an integer >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number of worker processes >= 1, got {text!r}")
-    return value
+#: ``--workers``: a whole number >= 1.
+positive_int = whole_number(1, "worker processes")
 
 
 def scheduler_address(text: str) -> str:

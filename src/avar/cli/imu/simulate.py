@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from avar._escape import terminal_lines
-from avar.cli.common import Progress, UsageError, add_rate_arguments, printable, seed_number
+from avar.cli.common import Progress, UsageError, add_rate_arguments, printable, seed_number, whole_number
 from avar.cli.outputs import PENDING, check_output_path, csv_text, rename_no_replace, write_all
 
 #: Log formats by extension.
@@ -206,15 +206,8 @@ def add_parser(commands) -> None:
     simulate.set_defaults(handler=run)
 
 
-def recheck_count(text: str) -> int:
-    """``--recheck R``: a whole number of simulated logs >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number of simulated logs >= 1, got {text!r}")
-    return value
+#: ``--recheck R``: a whole number of simulated logs >= 1.
+recheck_count = whole_number(1, "simulated logs")
 
 
 def add_recheck_arguments(parser: argparse.ArgumentParser) -> None:
