@@ -4,6 +4,7 @@ Usage::
 
     python benchmarks/bench_deviations.py            # N = 1e5, 1e6, 1e7 (totdev up to 1e6)
     python benchmarks/bench_deviations.py --quick    # N = 1e5, 1e6, one repeat
+    python benchmarks/bench_deviations.py --acceptance  # N = 1e6 alone, 5 repeats, no catalogue
     python benchmarks/bench_deviations.py --total    # MTOTDEV, TTOTDEV, HTOTDEV, Theo1, ThêoH
     python benchmarks/bench_deviations.py --total --sizes 1000 3000 100000
 
@@ -189,6 +190,8 @@ def bench_total(sizes: list[int], peer_max: int, loop_max: int) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="N = 1e5 and 1e6, one repeat")
+    parser.add_argument("--acceptance", action="store_true",
+                        help="N = 1e6 alone (the acceptance point), 5 repeats, without the catalogue")
     parser.add_argument("--total", action="store_true", help="the total and Theo statistics instead")
     parser.add_argument("--sizes", type=int, nargs="+", default=[3000, 100000, 1000000],
                         help="N of --total (default 3e3 1e5 1e6)")
@@ -200,8 +203,8 @@ def main() -> None:
     if args.total:
         bench_total(args.sizes, args.peer_max, args.loop_max)
         return
-    sizes = [10**5, 10**6] if args.quick else [10**5, 10**6, 10**7]
-    repeat = 1 if args.quick else 3
+    sizes = [ACCEPTANCE_N] if args.acceptance else [10**5, 10**6] if args.quick else [10**5, 10**6, 10**7]
+    repeat = 5 if args.acceptance else 1 if args.quick else 3
     print("| estimator | N | levels | allantools (ms) | allantools full (ms) | avar core (ms) | avar (ms) "
           "| core vs allantools | avar vs allantools | avar vs allantools full |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -236,8 +239,9 @@ def main() -> None:
         print(f"\nAcceptance (public function >= {TARGET:g}x the plain allantools call at N = {ACCEPTANCE_N:.0e}):")
         for estimator, ratio in public_ratio.items():
             print(f"  {estimator:7s} {ratio:5.2f}x  {'holds' if ratio >= TARGET else 'NOT MET'}")
-    print("\nThe rest of the catalogue (benchmarks/bench_catalogue.py):")
-    bench_catalogue.main(quick=args.quick)
+    if not args.acceptance:
+        print("\nThe rest of the catalogue (benchmarks/bench_catalogue.py):")
+        bench_catalogue.main(quick=args.quick)
 
 
 if __name__ == "__main__":

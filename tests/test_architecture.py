@@ -158,15 +158,7 @@ TUPLE_RETURNS_ALLOWED = {
     "avar._kernels.dd.fast_two_sum": "Dekker's FastTwoSum: as two_sum",
 }
 #: Still to convert by their owners (issue 37); remove each entry with its conversion.
-TUPLE_RETURNS_PENDING = {
-    f"avar._kernels.{name}": "kernels of the allan, classic and uncertainty families, converted separately"
-    for name in ("allan.blocks.block_table", "allan.blocks.point", "allan.blocks.window_level_sums",
-                 "allan.columns.column_kernels", "allan.far_steps.table_base", "allan.haar.haar_sums",
-                 "classic.levels.level_sums", "classic.phase.phase_increment", "classic.phase.scan",
-                 "uncertainty.noise_id.lag1_kernels")
-} | {
-    "avar.plotting.masks.mask_line": "new this round, read by plotting/deviation.py",
-}
+TUPLE_RETURNS_PENDING: dict[str, str] = {}
 
 
 def _tuple_valued(node: ast.expr, tuple_functions: set[str]) -> bool:

@@ -117,8 +117,8 @@ def plot_deviation(
         found = find_mask(mask, x.estimator)
         top = max(float(np.max(x.taus)), 10 * found.pieces[-1].low)
         draw_mask(ax, found, top)
-        taus, limits = mask_line(found, top)
-        drawn.append(limits[(taus >= np.min(x.taus)) & (taus <= np.max(x.taus))])
+        line = mask_line(found, top)
+        drawn.append(line.limits[(line.taus >= np.min(x.taus)) & (line.taus <= np.max(x.taus))])
     if ylab is None:
         ylab = f"{x.name} $\\sigma_x(\\tau)$ (s)" if x.estimator in ("tdev", "ttotdev") else f"{x.name} $\\sigma_y(\\tau)$"
     xlab = r"Averaging time $\tau$ (s)" if xlab is None else xlab

@@ -7,6 +7,8 @@ mask's line on any axes (also ``Deviation.plot(mask=...)``).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -18,7 +20,15 @@ from avar.stability.time_error.masks import Mask, MaskCheck
 CURVE_POINTS = 60
 
 
-def mask_line(mask: Mask, top: float) -> tuple[np.ndarray, np.ndarray]:
+class MaskLine(NamedTuple):
+    """The points of a mask's line: averaging or observation times ``taus`` (s) and the ``limits``
+    there (s for MTIE and TDEV, dimensionless for a frequency deviation)."""
+
+    taus: np.ndarray
+    limits: np.ndarray
+
+
+def mask_line(mask: Mask, top: float) -> MaskLine:
     """The (tau, limit) points of ``mask``'s line (s, s): each piece from its low end to its high end
     (``top`` for an open end). A piece of one power law is straight on log-log axes: its two ends;
     a sum of power laws: :data:`CURVE_POINTS` points. A piece's ends are the mask's breakpoints."""
@@ -32,13 +42,13 @@ def mask_line(mask: Mask, top: float) -> tuple[np.ndarray, np.ndarray]:
                 else np.geomspace(piece.low, high, CURVE_POINTS))
         taus.append(grid)
         limits.append(piece.limit(grid))
-    return np.concatenate(taus), np.concatenate(limits)
+    return MaskLine(np.concatenate(taus), np.concatenate(limits))
 
 
 def draw_mask(ax: Axes, mask: Mask, top: float, colour="0.3") -> None:
     """The mask's limit as a dashed line on ``ax``, labelled with its name (plain text)."""
-    taus, limits = mask_line(mask, top)
-    ax.plot(taus, limits, color=colour, linestyle="--", label=mask.name.replace("$", r"\$"), zorder=1)
+    line = mask_line(mask, top)
+    ax.plot(line.taus, line.limits, color=colour, linestyle="--", label=mask.name.replace("$", r"\$"), zorder=1)
 
 
 def plot_mask_check(check: MaskCheck, ax: Axes | None = None) -> Figure:

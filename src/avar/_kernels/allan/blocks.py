@@ -33,6 +33,8 @@ on the number of threads.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit, types
 from numba.extending import overload
@@ -54,6 +56,34 @@ NEAR_LEN = 2 * NEAR + 4 * BLOCK
 
 #: Magnitudes outside [2**-LIMIT_EXP, 2**LIMIT_EXP] are rescaled by a power of two.
 LIMIT_EXP = 400
+
+
+class Pair(NamedTuple):
+    """A double-double value ``hi + lo`` (``|lo|`` about an ulp of ``hi`` or less); built inside
+    compiled kernels too (numba types a NamedTuple as a tuple)."""
+
+    hi: float
+    lo: float
+
+
+class BlockTable(NamedTuple):
+    """:func:`block_table`'s pass over the data: ``table_hi + table_lo`` (C, blocks + 1) the centred
+    cumulative sum at every block boundary, ``centre`` (C,), ``maxabs`` (C,) the largest magnitude,
+    ``spread`` (C, blocks) a bound on ``|x * scale - centre|`` over every block."""
+
+    table_hi: np.ndarray
+    table_lo: np.ndarray
+    centre: np.ndarray
+    maxabs: np.ndarray
+    spread: np.ndarray
+
+
+class Window(NamedTuple):
+    """Where the sliding window of :func:`window_level_sums` starts (``start``, a sample index) and
+    how many samples past it it holds (``filled``)."""
+
+    start: int
+    filled: int
 
 
 def read_only(x: np.ndarray) -> np.ndarray:
@@ -139,7 +169,7 @@ def table_task(data, col, b0, b1, block, scale, ph, pl, low, high):
 
 
 def block_table(data, scale, integral, block=BLOCK):
-    """Pass 1 over all columns: returns (table_hi, table_lo, centre, maxabs, spread).
+    """Pass 1 over all columns: a :class:`BlockTable` (table_hi, table_lo, centre, maxabs, spread).
 
     ``table_*`` have shape (C, ceil(N / block) + 1) with the centred
     cumulative sum of ``data * scale`` at every block boundary (and at N), in
@@ -177,7 +207,7 @@ def block_table(data, scale, integral, block=BLOCK):
         table_hi, table_lo = _less_centre(table_hi, table_lo, centre[:, None], block, n)
         maxabs = np.max(np.maximum(-low, high), axis=1)
         spread = np.maximum(high - centre[:, None], centre[:, None] - low) * (1.0 + 2.0**-40)
-    return table_hi, table_lo, centre, maxabs, spread
+    return BlockTable(table_hi, table_lo, centre, maxabs, spread)
 
 
 def _dd_add(ah, al, bh, bl):
@@ -262,7 +292,7 @@ def fill_running(data, col, start, stop, centre, scale, s_hi, s_lo, out_hi, out_
 
 @njit(cache=True)
 def point(data, col, p, centre, scale, table_hi, table_lo, block):
-    """Centred ``S[p]`` as ``(hi, lo)``: the table entry below ``p`` plus a partial block."""
+    """Centred ``S[p]`` as a :class:`Pair` ``(hi, lo)``: the table entry below ``p`` plus a partial block."""
     q = p // block
     total = table_hi[col, q]
     comp = table_lo[col, q]
@@ -271,7 +301,7 @@ def point(data, col, p, centre, scale, table_hi, table_lo, block):
         yh, yl = _centred(x[i], centre, scale)
         total, e = two_sum(total, yh)
         comp += e + yl
-    return total, comp
+    return Pair(total, comp)
 
 
 @njit(cache=True, inline="always")
@@ -360,7 +390,7 @@ def window_level_sums(data, col, t0, need, centre, scale, wh, wl, w0, filled, fa
 
     The window holds the compensated prefix sums ``S[w0 .. w0 + filled]`` in ``wh``/``wl``; it slides to
     start at ``t0`` when ``need`` would overrun its length and is filled up to ``need``. Adds into
-    ``out_row[:count]`` and returns the new ``(w0, filled)``. ``bounds``: the largest
+    ``out_row[:count]`` and returns the new :class:`Window` ``(w0, filled)``. ``bounds``: the largest
     ``|wh|`` and ``|wl|`` the window has held (for :func:`certified_squares`; kept by the caller).
     """
     if need - w0 >= wh.shape[0]:
@@ -378,4 +408,4 @@ def window_level_sums(data, col, t0, need, centre, scale, wh, wl, w0, filled, fa
         cnt = min(block, nd[k] - t0)
         if cnt > 0:
             out_row[k] += certified_squares(wh, wl, a, factors[k], cnt, buffer, bounds)
-    return w0, filled
+    return Window(w0, filled)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from avar._kernels.allan.blocks import (
@@ -34,6 +36,16 @@ SMALL_MAX = 1 << 15
 #: 1.44 M samples), but compiling the sweep, far and block-table kernels costs about 4 s more
 #: on a cold cache than the small path: a typical log's first report would wait for them.
 SMALL_MO_MAX = 1 << 22
+
+
+#: A last group of far levels of at most this many levels is merged into the group before (see
+#: :func:`run_sweep`): every group computes its local prefixes once, which costs about as much as
+#: two levels (at N = 1e7, the octave levels 2**21 and 2**22 as a group of their own took 10 %
+#: more CPU time in all than one group of eight with a 2 MB ring).
+FAR_TAIL = 2
+
+#: ... provided the merged group's largest factor is at most this many times ``span`` its smallest.
+FAR_TAIL_RATIO = 4
 
 
 def _scales(maxabs):
@@ -103,7 +115,9 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
     by the cache-blocked sweep (:mod:`avar._kernels.allan.sweep`), the others by residue class
     (:mod:`avar._kernels.allan.far`, table granularity ``fine``, certification tolerance ``tol``),
     in groups whose largest factor is at most ``span`` times their smallest (a task's ring
-    of local prefixes holds ``2 span + 2`` pieces: 8 MB by default, whatever N)."""
+    of local prefixes holds ``2 span + 2`` pieces: 528 kB by default, whatever N); a last
+    group of at most :data:`FAR_TAIL` levels joins the one before when the whole stays within
+    ``FAR_TAIL_RATIO span`` (a ring of at most 2 MB)."""
     data = read_only(data)
     n_small = int(np.searchsorted(factors, near))
     fine = min(fine, int(factors[n_small])) if n_small < factors.shape[0] else fine
@@ -115,6 +129,8 @@ def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=N
     start = n_small
     while start < factors.shape[0]:
         stop = int(np.searchsorted(factors, factors[start] * span, side="right"))
+        if factors.shape[0] - stop <= FAR_TAIL and factors[-1] <= factors[start] * span * FAR_TAIL_RATIO:
+            stop = factors.shape[0]  # a short last group joins this one: its prefixes would cost more than its ring
         sums[:, start:stop] = far_sums(data.T, scale, centre, th, tl, spread, factors[start:stop], n_diff[start:stop],
                                        fine, tol)
         start = stop
@@ -138,20 +154,28 @@ def _as_kernel_input(data) -> np.ndarray:
     return read_only(x)
 
 
-def column_kernels(data, factors, type: str) -> tuple:
+class KernelCall(NamedTuple):
+    """A compiled loop and the first argument it would be called with: an entry of
+    :func:`avar._kernels.runtime.paths.compiled` (a tuple ``(kernel, argument)``)."""
+
+    kernel: object
+    argument: object
+
+
+def column_kernels(data, factors, type: str) -> list[KernelCall]:
     """The compiled loops :func:`allan_variance_columns` runs on series of up to
-    :data:`SMALL_MO_MAX` samples, as ``(kernel, first argument)`` entries of
+    :data:`SMALL_MO_MAX` samples, as :class:`KernelCall` entries of
     :func:`avar._kernels.runtime.paths.compiled` (whether they are compiled yet, for this dtype)."""
     x = _as_kernel_input(data)
     f = np.asarray(factors, dtype=np.int64).reshape(-1)
     n = x.shape[0]
     if n <= SMALL_MAX:
-        return ((small_allan_variance, x),)
+        return [KernelCall(small_allan_variance, x)]
     if type == "mo":
-        return ((small_allan_variance, x), (PARALLEL_KERNEL, np.empty(0)))
+        return [KernelCall(small_allan_variance, x), KernelCall(PARALLEL_KERNEL, np.empty(0))]
     if f.size and np.all((f & (f - 1)) == 0):
-        return ((HAAR_KERNEL, x.T),)
-    return ((table_task, x), (to_task, x))
+        return [KernelCall(HAAR_KERNEL, x.T)]
+    return [KernelCall(table_task, x), KernelCall(to_task, x)]
 
 
 def allan_variance_columns(data, factors, type: str) -> np.ndarray:

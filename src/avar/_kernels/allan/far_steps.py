@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
+from avar._kernels.allan.blocks import Pair
 from avar._kernels.allan.haar import exact_pair
 from avar._kernels.dd import two_sum
 from avar._kernels.runtime.tasks import run_tasks
@@ -103,10 +104,10 @@ def chained_squares(start, steps, count):
 
 @njit(cache=True, inline="always")
 def table_base(th, tl, col, k0, k1, k2):
-    """``S[k2 F] - 2 S[k1 F] + S[k0 F]`` from the table (granularity ``F``), as a double-double."""
+    """``S[k2 F] - 2 S[k1 F] + S[k0 F]`` from the table (granularity ``F``), as a double-double :class:`Pair`."""
     s, e = two_sum(th[col, k2], -2.0 * th[col, k1])
     s, e2 = two_sum(s, th[col, k0])
-    return s, (e + e2) + ((tl[col, k2] - 2.0 * tl[col, k1]) + tl[col, k0])
+    return Pair(s, (e + e2) + ((tl[col, k2] - 2.0 * tl[col, k1]) + tl[col, k0]))
 
 
 @njit(cache=True, nogil=True)

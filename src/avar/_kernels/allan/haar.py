@@ -25,6 +25,8 @@ of threads.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit, types
 from numba.extending import overload
@@ -251,10 +253,19 @@ def _combine(sums, fh, fl, lh, ll, have, bh, bl, n_full, levels, n_levels):
     return out
 
 
+class HaarSums(NamedTuple):
+    """:func:`haar_sums`: ``sums`` (C, levels) of squared differences of consecutive cluster sums,
+    and ``big`` (C,) the largest magnitude of ``data * scale`` per column (nan when a sample is
+    not finite)."""
+
+    sums: np.ndarray
+    big: np.ndarray
+
+
 def haar_sums(data, scale, n_levels, exp=PYRAMID_EXP, chunk=CHUNK_BLOCKS):
     """Sums of squared differences of consecutive cluster sums at m = 2**k, k < ``n_levels``.
 
-    Returns ``(sums, big)``: shape (C, n_levels), and the largest magnitude of
+    Returns :class:`HaarSums` ``(sums, big)``: shape (C, n_levels), and the largest magnitude of
     ``data * scale`` per column (to rescale extreme data and run again; nan
     when a sample is not finite).
     """
@@ -278,7 +289,7 @@ def haar_sums(data, scale, n_levels, exp=PYRAMID_EXP, chunk=CHUNK_BLOCKS):
 
     run_tasks(channels * n_tasks, task)
     out = _combine(sums, fh, fl, lh, ll, have, bh, bl, n // block, levels, n_levels)
-    return out, big.max(axis=1)
+    return HaarSums(out, big.max(axis=1))
 
 
 #: The compiled loop of :func:`haar_sums`, which reads the data's rows (``data.T``): whether it is

@@ -36,6 +36,9 @@ Term by term, in O(1) each
 
 Terms are split into tasks of a fixed size (a function of the level only), so
 the summation order, and the result, does not depend on the number of threads.
+Gap-free levels of stride 1 (OHDEV, MDEV, TOTDEV, MHDEV) go by blocks of terms,
+every level per block (:func:`fused_sums`): the phase around a block is read
+from memory once for the small levels.
 
 Gaps
 ----
@@ -50,13 +53,23 @@ cumulative sum (any finite value keeps the other terms exact).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from avar._kernels.classic.phase import detrended_phase, scan  # noqa: F401 (re-exported)
-from avar._kernels.classic.sums import contiguous_squares, difference_kernels, squared_difference_sums
+from avar._kernels.classic.sums import (
+    FUSED_BLOCK,
+    FUSED_MAX_LEVELS,
+    contiguous_squares,
+    contiguous_third,
+    difference_kernels,
+    square_sum,
+    squared_difference_sums,
+)
 from avar._kernels.dd import fast_sum
-from avar._kernels.runtime.tasks import run_ranges
+from avar._kernels.runtime.tasks import run_ranges, run_tasks
 
 #: Terms per parallel task (MDEV tasks span at least m terms).
 CHUNK = 1 << 15
@@ -169,34 +182,6 @@ def _valid(code, bad, mode, b, m, last):
 
 
 @njit(cache=True)
-def _contiguous_third(hi, lo, m, start, count, buffer):
-    """Third differences at ``b = start .. start + count - 1`` into ``buffer`` (vectorized)."""
-    h0 = hi[start : start + count]
-    h1 = hi[start + m : start + m + count]
-    h2 = hi[start + 2 * m : start + 2 * m + count]
-    h3 = hi[start + 3 * m : start + 3 * m + count]
-    l0 = lo[start : start + count]
-    l1 = lo[start + m : start + m + count]
-    l2 = lo[start + 2 * m : start + 2 * m + count]
-    l3 = lo[start + 3 * m : start + 3 * m + count]
-    for j in range(count):
-        a1 = h1[j] - h0[j]
-        a2 = h2[j] - h1[j]
-        a3 = h3[j] - h2[j]
-        b1 = l1[j] - l0[j]
-        b2 = l2[j] - l1[j]
-        b3 = l3[j] - l2[j]
-        buffer[j] = ((a3 - a2) - (a2 - a1)) + np.float64((b3 - b2) - (b2 - b1))
-
-
-@njit(cache=True)
-def _squares(buffer, count):
-    for j in range(count):
-        buffer[j] = buffer[j] * buffer[j]
-    return fast_sum(buffer, count)
-
-
-@njit(cache=True)
 def _totdev_term(hi, lo, k, m, last):
     return _reflected_minus(hi, lo, k - m, k, last) + _reflected_minus(hi, lo, k + m, k, last)
 
@@ -258,8 +243,8 @@ def _fast_task_sum(hi, lo, code, m, stride, first, last_term, buffer):
             if code == 0:
                 total += contiguous_squares(hi, lo, m, start, count, buffer)
             else:
-                _contiguous_third(hi, lo, m, start, count, buffer)
-                total += _squares(buffer, count)
+                contiguous_third(hi, lo, m, start, count, buffer)
+                total += square_sum(buffer, count)
         else:
             for j in range(count):
                 b = (start + j) * stride
@@ -326,6 +311,41 @@ def task_sums(hi, lo, code, task_m, task_stride, task_first, task_last, mode, ba
     return sums, counts
 
 
+@njit(cache=True, nogil=True)
+def _fused_block(hi, lo, code, b, factors, firsts, lasts, block, out):
+    """The sums of every gap-free level of stride 1 over terms ``[b block, (b + 1) block)``."""
+    buffer = np.empty(BLOCK)
+    for k in range(factors.shape[0]):
+        start = max(b * block, firsts[k])
+        stop = min((b + 1) * block, lasts[k])
+        out[b, k] = _fast_task_sum(hi, lo, code, factors[k], 1, start, stop, buffer) if start < stop else 0.0
+
+
+def fused_sums(hi, lo, code, factors, firsts, lasts, block=FUSED_BLOCK):
+    """Sums of squared terms of every gap-free level of stride 1 (OHDEV, MDEV, TOTDEV, MHDEV), one
+    block of terms for all levels per task (as :func:`avar._kernels.classic.sums.fused_overlapping_sums`):
+    the phase around a block is read from memory once for the small levels. Level ``k`` sums terms
+    ``firsts[k] .. lasts[k] - 1``; the blocks' sums are added in order (the bits do not depend
+    on the number of threads)."""
+    n_blocks = max(1, -(-int(np.max(lasts, initial=0)) // block))
+    out = np.zeros((n_blocks, factors.shape[0]))
+    run_tasks(n_blocks, lambda b: _fused_block(hi, lo, code, b, factors, firsts, lasts, block, out))
+    return out.sum(axis=0)
+
+
+class LevelSums(NamedTuple):
+    """Sum of squared terms and number of terms used, level by level (:func:`level_sums`)."""
+
+    sums: np.ndarray
+    counts: np.ndarray
+
+
+def _fused(code, mode, strides, n_levels):
+    """Whether :func:`level_sums` takes :func:`fused_sums`: gap-free levels of stride 1 (OHDEV, MDEV,
+    TOTDEV, MHDEV), few enough for its table."""
+    return code != 0 and mode == 0 and n_levels <= FUSED_MAX_LEVELS and bool(np.all(np.asarray(strides) == 1))
+
+
 def level_sums(hi, lo, code, factors, strides, firsts, lasts, mode=0, bad=None, chunk=CHUNK):
     """Sum of squared terms and number of terms used, level by level.
 
@@ -342,13 +362,18 @@ def level_sums(hi, lo, code, factors, strides, firsts, lasts, mode=0, bad=None, 
 
     Returns
     -------
-    sums : float64 array, counts : int64 array
+    LevelSums
+        ``sums`` (float64 array), ``counts`` (int64 array).
     """
     factors = np.asarray(factors, dtype=np.int64)
     if code == 0 and mode == 0:
         counts = np.asarray(lasts, dtype=np.int64) - np.asarray(firsts, dtype=np.int64)
         sums = squared_difference_sums(hi[None, :], lo[None, :], factors, np.asarray(strides, dtype=np.int64), counts)
-        return sums[0], counts
+        return LevelSums(sums[0], counts)
+    if _fused(code, mode, strides, factors.shape[0]):
+        firsts = np.asarray(firsts, dtype=np.int64)
+        lasts = np.asarray(lasts, dtype=np.int64)
+        return LevelSums(fused_sums(hi, lo, code, factors, firsts, lasts), np.maximum(lasts - firsts, 0))
     span = np.asarray(lasts, dtype=np.int64) - np.asarray(firsts, dtype=np.int64)
     size = np.full_like(factors, chunk)
     per_level = np.maximum(1, -(-span // size))
@@ -362,7 +387,7 @@ def level_sums(hi, lo, code, factors, strides, firsts, lasts, mode=0, bad=None, 
         hi, lo, code, factors[level], np.asarray(strides, dtype=np.int64)[level], first, last, mode, bad
     )
     n_levels = factors.shape[0]
-    return (
+    return LevelSums(
         np.bincount(level, weights=sums, minlength=n_levels),
         np.bincount(level, weights=counts, minlength=n_levels).astype(np.int64),
     )
@@ -373,4 +398,6 @@ def level_kernels(code, strides, mode=0):
     compiled yet: :func:`avar._kernels.runtime.paths.compiled`)."""
     if code == 0 and mode == 0:
         return difference_kernels(strides, len(strides))
+    if _fused(code, mode, strides, len(strides)):
+        return (_fused_block,)
     return (_task_range,)

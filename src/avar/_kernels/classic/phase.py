@@ -9,6 +9,8 @@ by a compensated running sum ``hi + lo``.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
@@ -16,6 +18,16 @@ from avar._kernels.classic.sums import CUMSUM_BLOCK
 from avar._kernels.dd import two_sum
 from avar._kernels.runtime.paths import numpy_path
 from avar._kernels.runtime.tasks import run_tasks
+
+
+class Scanned(NamedTuple):
+    """One pass over the data (:func:`scan`)."""
+
+    n_missing: int
+    total: float
+    low: float
+    high: float
+    moment: float
 
 
 @njit(cache=True)
@@ -90,15 +102,15 @@ def _numpy_scan(data, weigh):
     count = int(np.count_nonzero(missing))
     values = data[~missing] if count else data
     if values.shape[0] == 0:
-        return count, 0.0, np.inf, -np.inf, np.nan
+        return Scanned(count, 0.0, np.inf, -np.inf, np.nan)
     moment = np.nan
     if weigh and count == 0:
         moment = float(np.einsum("i,i", np.arange(data.shape[0], dtype=np.float64) - (data.shape[0] - 1) / 2.0, data))
-    return count, float(np.sum(values)), float(np.min(values)), float(np.max(values)), moment
+    return Scanned(count, float(np.sum(values)), float(np.min(values)), float(np.max(values)), moment)
 
 
 def scan(data, block=CUMSUM_BLOCK, weigh=False):
-    """Number of NaN, and sum, minimum and maximum of the other values, in one pass on the threads;
+    """Number of NaN, and sum, minimum and maximum of the other values (a :class:`Scanned`), in one pass on the threads;
     with ``weigh`` and no NaN, also the centred moment ``sum_i (i - (N - 1) / 2) data_i``
     (the numerator of the least-squares slope; NaN otherwise). Short records by NumPy while
     the kernels are cold (:data:`NUMPY_SCAN`)."""
@@ -119,12 +131,19 @@ def scan(data, block=CUMSUM_BLOCK, weigh=False):
     count = int(nans.sum())
     low = float(lows.min()) if n_blocks else np.inf
     high = float(highs.max()) if n_blocks else -np.inf
-    return count, total, low, high, moment if count == 0 and weigh else np.nan
+    return Scanned(count, total, low, high, moment if count == 0 and weigh else np.nan)
+
+
+class Increment(NamedTuple):
+    """One increment of the phase as an exact pair ``hi + lo`` (:func:`phase_increment`)."""
+
+    hi: float
+    lo: float
 
 
 @njit(cache=True, inline="always")
 def phase_increment(data, data_lo, i, kind, centre, slope, scale):
-    """Increment ``i`` minus ``centre + slope i``, times ``scale``, as an exact pair."""
+    """Increment ``i`` minus ``centre + slope i``, times ``scale``, as an exact pair (an :class:`Increment`)."""
     if kind == 1:
         h, l = two_sum(data[i + 1], -data[i])
     elif kind == 2:
@@ -142,7 +161,7 @@ def phase_increment(data, data_lo, i, kind, centre, slope, scale):
     if slope != 0.0:
         h, e1 = two_sum(h, -(slope * i))
         l += e1
-    return h * scale, l * scale
+    return Increment(h * scale, l * scale)
 
 
 @njit(cache=True, nogil=True)

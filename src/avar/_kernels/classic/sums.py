@@ -161,6 +161,36 @@ def contiguous_squares(hi, lo, m, start, count, buffer):
 
 
 @njit(cache=True)
+def contiguous_third(hi, lo, m, start, count, buffer):
+    """Third differences ``S[b + 3m] - 3 S[b + 2m] + 3 S[b + m] - S[b]`` at ``b = start .. start + count - 1``
+    into ``buffer`` (vectorized; HDEV's and OHDEV's terms, and MDEV's of the running sum)."""
+    h0 = hi[start : start + count]
+    h1 = hi[start + m : start + m + count]
+    h2 = hi[start + 2 * m : start + 2 * m + count]
+    h3 = hi[start + 3 * m : start + 3 * m + count]
+    l0 = lo[start : start + count]
+    l1 = lo[start + m : start + m + count]
+    l2 = lo[start + 2 * m : start + 2 * m + count]
+    l3 = lo[start + 3 * m : start + 3 * m + count]
+    for j in range(count):
+        a1 = h1[j] - h0[j]
+        a2 = h2[j] - h1[j]
+        a3 = h3[j] - h2[j]
+        b1 = l1[j] - l0[j]
+        b2 = l2[j] - l1[j]
+        b3 = l3[j] - l2[j]
+        buffer[j] = ((a3 - a2) - (a2 - a1)) + np.float64((b3 - b2) - (b2 - b1))
+
+
+@njit(cache=True)
+def square_sum(buffer, count):
+    """``sum(buffer[:count] ** 2)``, squaring in place (vectorized)."""
+    for j in range(count):
+        buffer[j] = buffer[j] * buffer[j]
+    return fast_sum(buffer, count)
+
+
+@njit(cache=True)
 def _strided_squares(hi, lo, m, stride, start, count, buffer):
     """Sum of ``D_k**2`` for ``k = start .. start + count - 1``, windows ``stride`` apart."""
     for j in range(count):

@@ -18,8 +18,10 @@ The dispatching points: the deviation family's phase and levels
 (:func:`avar.stability.classic.core.numpy_levels`, twin :mod:`avar.stability.classic.small`),
 its noise identification (:mod:`avar.stability.uncertainty.lag1`), the scan of the data
 (:func:`avar._kernels.classic.phase.scan`), Greenhall's EDF sums
-(:func:`avar._kernels.uncertainty.edf.greenhall_sums`) and the Allan variance
-(:func:`avar.stability.allan.columns.numpy_columns`). Where a twin cannot certify its
+(:func:`avar._kernels.uncertainty.edf.greenhall_sums`), the Allan variance
+(:func:`avar.stability.allan.columns.numpy_columns`) and the total family's phase, MTOTDEV,
+TTOTDEV and HTOTDEV levels and Theo1 levels (:mod:`avar.stability.total.deviations`, twin
+:mod:`avar.stability.total.small`). Where a twin cannot certify its
 result (adversarial data), or cannot apply (gaps), the kernels run whatever this says.
 
 Forcing one path (the tests run the exactness tests on each): the environment variable

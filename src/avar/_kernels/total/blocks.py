@@ -57,6 +57,7 @@ exact formula.
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -88,8 +89,25 @@ def _power_sums(m: int) -> list[int]:
             n * m * (2 * n + 1) * (3 * n * n + 3 * n - 1) // 30]
 
 
+class LevelTables(NamedTuple):
+    """The exact tables of one level's expansion (:func:`level_tables`), in the order :func:`_blocks` takes them."""
+
+    same: np.ndarray
+    pairs: np.ndarray
+    cross: np.ndarray
+    points: np.ndarray
+    square: np.ndarray
+
+
+class Blocks(NamedTuple):
+    """First windows and window counts of the blocks of one level (:func:`blocks`)."""
+
+    starts: np.ndarray
+    counts: np.ndarray
+
+
 @lru_cache(maxsize=1024)
-def level_tables(m: int) -> tuple[np.ndarray, ...]:
+def level_tables(m: int) -> LevelTables:
     """The expansion of one level (see the module docstring), from exact integers:
 
     ``same`` rows (lag / m, first position, weight): sum_n sum_{u<m} X(n + lo + u) X(n + lo + u + lag);
@@ -140,7 +158,7 @@ def level_tables(m: int) -> tuple[np.ndarray, ...]:
             points[xi, i] -= q0 / 2
             points[xi, i + 1] += (q0 + q1 * m + q2 * m * m) / 2
     assert not cross[:2, :, 1:].any()  # pi_X and pi_mu do not depend on j'
-    return same_rows, pairs, cross, points, square.astype(np.float64) / 4.0
+    return LevelTables(same_rows, pairs, cross, points, square.astype(np.float64) / 4.0)
 
 
 @njit(cache=True, nogil=True)
@@ -310,6 +328,11 @@ def _blocks(values, m, starts, counts, first, stop, same, opposite, cross, point
                   + _windows(x, moments, cross, points, square, count, m)) / scale
 
 
+#: The compiled kernels a blocked level runs (a NumPy twin stands in while they are cold:
+#: :mod:`avar.stability.total.small`).
+BLOCK_KERNELS = (_blocks,)
+
+
 #: Windows per block, in units of m: each block reads (BLOCK + 3) m values. Larger blocks
 #: spend less on each block's set-up but lose accuracy as (BLOCK / 3)^3 (module docstring).
 BLOCK = 3
@@ -329,19 +352,19 @@ def block_size(m: int) -> int:
     return max(BLOCK * m, MIN_BLOCK)
 
 
-def blocks(n_terms: int, size: int, clean: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def blocks(n_terms: int, size: int, clean: np.ndarray | None = None) -> Blocks:
     """First windows and window counts of the blocks: runs of at most ``size`` windows covering
     the windows 0 .. n_terms - 1, or only those where ``clean`` (one flag per window) is set."""
     if clean is None:
         starts = np.arange(0, n_terms, size, dtype=np.int64)
-        return starts, np.minimum(size, n_terms - starts)
+        return Blocks(starts, np.minimum(size, n_terms - starts))
     edges = np.diff(np.concatenate(([0], clean.astype(np.int8), [0])))
     first, stop = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # runs of clean windows
     per_run = (stop - first + size - 1) // size
     run = np.repeat(np.arange(first.size), per_run)
     index = np.arange(run.size) - np.repeat(np.cumsum(per_run) - per_run, per_run)
     starts = (first[run] + index * size).astype(np.int64)
-    return starts, np.minimum(size, stop[run] - starts).astype(np.int64)
+    return Blocks(starts, np.minimum(size, stop[run] - starts).astype(np.int64))
 
 
 def level_sum(values: np.ndarray, m: int, clean: np.ndarray | None = None) -> float:

@@ -144,6 +144,10 @@ def half_convolution(f: np.ndarray, g: np.ndarray, count: int) -> np.ndarray:
     return out[:count]
 
 
+#: The compiled kernel of the ends' autocorrelations (Theo1's expansion; TheoBR adds :func:`half_convolution`'s).
+HANKEL_KERNELS = (_hankel_leaves,)
+
+
 def phi_sums(z: np.ndarray, count: int) -> np.ndarray:
     """Φ(c) = sum_{j<c, j = c mod 2} 2 z_j / (c + j), c = 0 .. count - 1.
 

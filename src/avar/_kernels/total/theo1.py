@@ -113,6 +113,11 @@ def _weighted_lags(long: np.ndarray, short: np.ndarray, m: int) -> tuple[float, 
     return first, second
 
 
+#: The compiled kernels of the expansion (a NumPy twin stands in for them and the direct loop
+#: while they are cold: :func:`avar.stability.total.small.theo1_level_sums`).
+THEO1_KERNELS = (_plain_parts, _weighted_lags)
+
+
 def _end_autocorrelation(x: np.ndarray, reverse: np.ndarray, k: int) -> np.ndarray:
     """AC_k of the head plus AC_k of the tail (one inverse FFT for both)."""
     size = fft.next_fast_len(2 * k, real=True)

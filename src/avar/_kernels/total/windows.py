@@ -207,6 +207,10 @@ def _task_range(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: i
     return sums, counts
 
 
+#: The compiled kernels a direct level runs (serially: small levels).
+DIRECT_KERNELS = (_level_serial,)
+
+
 #: Levels with more window points than this (terms x window length) run on every thread.
 PARALLEL_WORK = 1 << 24
 

@@ -27,7 +27,14 @@ QUADRATIC = False
 
 
 @njit(cache=True, nogil=True)
-def lag1_alpha_decimated(x, m, dmax, line):
+def _point(x, k, half_drift):
+    """``x[k] + drift k (k - 1) / 2`` (``half_drift = drift / 2``), rounded as
+    :func:`avar.stability.uncertainty.lag1.with_drift` rounds it (no contraction: compiled apart)."""
+    return x[k] + ((k - 1.0) * k) * half_drift
+
+
+@njit(cache=True, nogil=True)
+def lag1_alpha_decimated(x, m, dmax, line, drift=0.0):
     """alpha of x[0], x[m], x[2m], ... by the lag-1 autocorrelation (Riley and Greenhall 2004).
 
     ``line`` NaN (phase integrated from frequency data): the decimated series
@@ -42,12 +49,15 @@ def lag1_alpha_decimated(x, m, dmax, line):
     r1 = (sum (z_i - zbar)(z_{i+1} - zbar) / n) / (sum (z_i - zbar)**2 / (n - 1)) and
     rho = r1 / (1 + r1), z is differenced until rho < 0.25 or d = dmax, and
     alpha = 2 - round(2 rho) - 2 d (round half to even, as ``numpy.round``).
+    ``drift``: ``x`` lacks ``drift * i (i - 1) / 2`` (a removed linear frequency drift), which
+    the decimated series gets back (as :func:`avar.stability.uncertainty.lag1.with_drift` adds it).
     Returns NaN for a constant series. Needs K >= 3 and dmax <= 3.
     """
+    half_drift = 0.5 * drift  # exact halving: (p / 2) drift and p (drift / 2) round alike
     k = (x.shape[0] - 1) // m + 1
     half = (k - 1) / 2.0
     c2 = (k * k - 1.0) / 12.0
-    s0, s1, s2 = _projections(x, m, k, half, c2)
+    s0, s1, s2 = _projections(x, m, k, half, c2, half_drift)
     kf = float(k)
     a0 = s0 / kf
     a1 = s1 / (kf * (kf * kf - 1.0) / 12.0)
@@ -55,10 +65,10 @@ def lag1_alpha_decimated(x, m, dmax, line):
     stats = np.zeros((4, 5))  # per order d: sum, sum of squares, lag-1 products, first, last value
     for d in range(dmax + 1):
         if d % 2 == 0:  # orders d and d + 1 in one pass (most series stop at d = 0 or 1)
-            _order_pass(x, m, k, half, c2, a0, a1, a2, d, stats)
+            _order_pass(x, m, k, half, c2, a0, a1, a2, d, stats, half_drift)
             if d == 0 and not np.isnan(line):  # order 0 of the phase as given: only its mean removed
                 given = np.zeros((2, 5))
-                _order_pass(x, m, k, half, c2, a0, -line * m, 0.0, 0, given)
+                _order_pass(x, m, k, half, c2, a0, -line * m, 0.0, 0, given, half_drift)
                 stats[0, :] = given[0, :]
         length = k - d
         total, squares, products, first, last = stats[d, 0], stats[d, 1], stats[d, 2], stats[d, 3], stats[d, 4]
@@ -75,13 +85,14 @@ def lag1_alpha_decimated(x, m, dmax, line):
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
-def _projections(x, m, k, half, c2):
-    """Sums of x[i m] times 1, t and t**2 - c2 (t = i - half)."""
+def _projections(x, m, k, half, c2, half_drift):
+    """Sums of x[i m] times 1, t and t**2 - c2 (t = i - half); ``half_drift`` (not 0): of
+    :func:`_point`."""
     s0 = 0.0
     s1 = 0.0
     s2 = 0.0
     for i in range(k):
-        v = x[i * m]
+        v = x[i * m] if half_drift == 0.0 else _point(x, i * m, half_drift)
         t = i - half
         s0 += v
         s1 += t * v
@@ -90,11 +101,12 @@ def _projections(x, m, k, half, c2):
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
-def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
+def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats, half_drift):
     """Stats of the differences of orders ``low`` and ``low + 1`` (0 or 2) of the residuals, streamed:
     per order, the sum, sum of squares, lag-1 sum of products, first and last value of its values
     less its first one (the lag-1 statistic is unchanged by the shift, and a constant far above the
-    noise, such as the second differences of a large frequency drift, cancels exactly first)."""
+    noise, such as the second differences of a large frequency drift, cancels exactly first).
+    ``half_drift`` (not 0): the points are :func:`_point`'s."""
     ta = tb = qa = qb = pa = pb = 0.0
     w0 = w1 = w2 = w3 = 0.0  # the latest value of every order
     fa = fb = 0.0
@@ -103,7 +115,7 @@ def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
     head = min(k, low + 2)
     for i in range(head):  # the first points, where the orders start: branches
         t = i - half
-        v0 = x[i * m] - (a0 + a1 * t + a2 * (t * t - c2))
+        v0 = (x[i * m] if half_drift == 0.0 else _point(x, i * m, half_drift)) - (a0 + a1 * t + a2 * (t * t - c2))
         v1 = v0 - w0
         v2 = v1 - w1
         v3 = v2 - w2
@@ -140,7 +152,7 @@ def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
         ua, ub = w0 - sa, w1 - sb
         for i in range(head, k):
             t = i - half
-            v0 = x[i * m] - (a0 + a1 * t + a2 * (t * t - c2))
+            v0 = (x[i * m] if half_drift == 0.0 else _point(x, i * m, half_drift)) - (a0 + a1 * t + a2 * (t * t - c2))
             v1 = v0 - w0
             va = v0 - sa
             vb = v1 - sb
@@ -155,7 +167,7 @@ def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
         ua, ub = w2 - sa, w3 - sb
         for i in range(head, k):
             t = i - half
-            v0 = x[i * m] - (a0 + a1 * t + a2 * (t * t - c2))
+            v0 = (x[i * m] if half_drift == 0.0 else _point(x, i * m, half_drift)) - (a0 + a1 * t + a2 * (t * t - c2))
             v1 = v0 - w0
             v2 = v1 - w1
             v3 = v2 - w2
@@ -175,32 +187,33 @@ def _order_pass(x, m, k, half, c2, a0, a1, a2, low, stats):
 
 
 @njit(cache=True, nogil=True)
-def lag1_levels(x, factors, dmax, line, out):
-    """:func:`lag1_alpha_decimated` at every factor into ``out``, serially."""
+def lag1_levels(x, factors, dmax, line, out, drift=0.0):
+    """:func:`lag1_alpha_decimated` at every factor into ``out``, serially (``drift`` as there)."""
     for i in range(factors.shape[0]):
-        out[i] = lag1_alpha_decimated(x, factors[i], dmax, line)
+        out[i] = lag1_alpha_decimated(x, factors[i], dmax, line, drift)
 
 
-def lag1_levels_split(x, factors, dmax, line, out):
+def lag1_levels_split(x, factors, dmax, line, out, drift=0.0):
     """:func:`lag1_levels` on two threads: the first level (the longest; at the octave
     m = 1 it holds half the points) on one, the others on the other."""
 
     def worker(w):
         if w == 0:
-            out[0] = lag1_alpha_decimated(x, factors[0], dmax, line)
+            out[0] = lag1_alpha_decimated(x, factors[0], dmax, line, drift)
         else:
-            _decimating_levels(x, factors, dmax, line, out)
+            _decimating_levels(x, factors, dmax, line, out, drift)
 
     run_tasks(2, worker)
 
 
 @njit(cache=True, nogil=True)
-def _decimating_levels(x, factors, dmax, line, out):
+def _decimating_levels(x, factors, dmax, line, out, drift):
     """Levels 1, 2, ... of :func:`lag1_levels_split`: where a factor is a multiple of the one
     before (octaves), the decimated points are taken from that level's contiguous copy
     (decimated in place) rather than from ``x`` at a long stride: the same values, fewer
-    cache lines read."""
+    cache lines read. The copy gets ``drift``'s points back (:func:`_point`)."""
     n = x.shape[0]
+    half_drift = 0.5 * drift
     buffer = np.empty((n - 1) // factors[1] + 1) if factors.shape[0] > 1 else np.empty(1)
     held = 0  # the factor whose points ``buffer`` holds (0: none)
     length = 0
@@ -215,16 +228,25 @@ def _decimating_levels(x, factors, dmax, line, out):
             length = (n - 1) // m + 1
             if length > buffer.shape[0]:
                 buffer = np.empty(length)
-            for j in range(length):
-                buffer[j] = x[j * m]
+            if half_drift == 0.0:
+                for j in range(length):
+                    buffer[j] = x[j * m]
+            else:
+                for j in range(length):
+                    buffer[j] = _point(x, j * m, half_drift)
         held = m
-        out[i] = lag1_alpha_decimated(buffer[:length], 1, dmax, line * m)
+        out[i] = lag1_alpha_decimated(buffer[:length], 1, dmax, line * m, 0.0)
+
+
+#: The compiled loops of :func:`lag1_levels_split` and of :func:`lag1_levels` (:func:`lag1_kernels`).
+SPLIT_KERNELS = (lag1_alpha_decimated, _decimating_levels)
+SERIAL_KERNELS = (lag1_levels,)
 
 
 def lag1_kernels(n_levels):
     """The compiled loops :func:`lag1_levels_split` (several levels) or :func:`lag1_levels` (one)
     runs (whether they are compiled yet: :func:`avar._kernels.runtime.paths.compiled`)."""
-    return (lag1_alpha_decimated, _decimating_levels) if n_levels > 1 else (lag1_levels,)
+    return SPLIT_KERNELS if n_levels > 1 else SERIAL_KERNELS
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST)

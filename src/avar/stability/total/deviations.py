@@ -7,8 +7,9 @@ for the shared conventions: frequency data become phase x = (0, cumsum(y))
 tau0, NaN gaps, confidence), plus ``alpha`` to fix the noise type and
 ``bias_correction``. The variances come from the kernels of
 :mod:`avar._kernels.total.windows` (which sends the long MTOTDEV and HTOTDEV levels to
-the O(N) expansion of :mod:`avar._kernels.total.blocks`); levels, EDF and
-bias from :mod:`avar.stability.uncertainty.total_edf`.
+the O(N) expansion of :mod:`avar._kernels.total.blocks`), or while those are not compiled
+yet, for short records, from their NumPy twins (:mod:`avar.stability.total.small`); levels,
+EDF and bias from :mod:`avar.stability.uncertainty.total_edf`.
 """
 
 from __future__ import annotations
@@ -17,16 +18,20 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from avar._kernels.total.fft import autocorrelation
-from avar._kernels.total.theo1 import theo1_sums
-from avar._kernels.total.windows import level_sums, theo1_sum
-from avar.stability.classic.core import phase_parts
+from avar._kernels.classic.phase import PHASE_KERNELS
+from avar._kernels.classic.sums import CUMSUM_BLOCK
+from avar._kernels.runtime.paths import numpy_path
+from avar._kernels.total.fft import HANKEL_KERNELS, autocorrelation
+from avar._kernels.total.theo1 import THEO1_KERNELS, theo1_sums
+from avar._kernels.total.windows import DIRECT_KERNELS, level_sums, theo1_sum
+from avar.stability.classic.core import phase_line, phase_parts
 from avar.stability.classic.deviations import noise_exponents
 from avar.stability.shared.deviation import Deviation
 from avar.stability.shared.grids import largest_factor, total_factors
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE, check_data, check_not_tiny, check_options
 from avar.stability.shared.noise_types import ALPHA_PARAMETER, check_alpha
 from avar.stability.shared.term_counts import levels_with_terms, term_counts
+from avar.stability.total import small
 from avar.stability.total.theobr import MIN_THEOBR_POINTS, theobr_factor
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES, chi2_bounds
 from avar.stability.uncertainty.total_edf import MTOT_EDF, htot_bias, theo1_bias, total_edf
@@ -103,7 +108,14 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
     needed = _MIN_PHASE.get(estimator, 3) - (data_type == "freq")
     if values.size < needed:
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
-    x, _, scale, _, bad, *_ = phase_parts(values, data_type, "ohdev" if estimator == "htotdev" else "oadev", scanned)
+    kind = "ohdev" if estimator == "htotdev" else "oadev"
+    n_increments = values.size - (data_type == "phase")
+    if numpy_path(n_increments, CUMSUM_BLOCK, PHASE_KERNELS, route=_PHASE_ROUTE):
+        # cold kernels, one block: the kernel's phase, bit for bit (:func:`avar.stability.total.small.twin_phase`)
+        filled, bad, _, centre, slope, scale = phase_line(values, data_type, kind, scanned)
+        x = small.twin_phase(filled, int(data_type == "phase"), centre, slope, scale)
+    else:
+        x, _, scale, _, bad, *_ = phase_parts(values, data_type, kind, scanned)
     bad = np.zeros(0, dtype=np.int64) if bad is None else np.ascontiguousarray(bad, dtype=np.int64)
     return PreparedPhase(values, rate, np.ascontiguousarray(x), bad, int(data_type == "freq"), scale,
                          values.size + (data_type == "freq"))
@@ -114,12 +126,16 @@ def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.nd
                   autocorr: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Unbiased-as-defined variances and term counts (NaN where no term is left); ``autocorr``:
     the FFT autocorrelation of gap-free ``x`` for Theo1, if at hand."""
-    if estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
+    if estimator == "theo1" and autocorr is None and numpy_path(
+            lambda: small.theo1_work(x.shape[0], factors) // small.THEO1_UNITS, small.THEO1_LIMIT,
+            THEO1_KERNELS + HANKEL_KERNELS + DIRECT_KERNELS, route=_THEO1_ROUTE):  # cold kernels: NumPy twin
+        sums, counts = small.theo1_level_sums(x, factors, bad, shift)
+    elif estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
         sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift).total, autocorr).sums
         counts = x.shape[0] - factors
     else:  # HTOTDEV's m = 1 is OHDEV (below): its level is not summed
         first = int(estimator == "htotdev" and factors.size > 0 and factors[0] == 1)
-        sums, counts = level_sums(_KIND[estimator], x, factors[first:], bad, shift)
+        sums, counts = _level_sums(_KIND[estimator], x, factors[first:], bad, shift)
         sums = np.concatenate((np.zeros(first), sums))
         counts = np.concatenate((np.zeros(first, dtype=counts.dtype), counts))
     m = factors.astype(np.float64)
@@ -136,6 +152,29 @@ def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.nd
         variance = variance / scale / scale * (rate * rate if is_phase else 1.0)
     variance[counts == 0] = np.nan
     return variance, counts
+
+
+def _level_sums(kind: int, x: np.ndarray, factors: np.ndarray, bad: np.ndarray,
+                shift: int) -> tuple[np.ndarray, np.ndarray]:
+    """MTOTDEV's (``kind`` 0) or HTOTDEV's (1) level sums and window counts: by the NumPy twin
+    (:mod:`avar.stability.total.small`) while the kernels the levels need are cold and the work
+    is small (:func:`avar._kernels.runtime.paths.numpy_path`) and the twin certifies its
+    rounding, else compiled."""
+    n_values = x.shape[0] - kind
+    kernels = small.compiled_kernels(kind, n_values, factors, bool(bad.size))  # (a loop over the factors)
+    route = (_LEVEL_ROUTE, *(id(kernel) for kernel in kernels))
+    if kind < 2 and factors.size and numpy_path(small.TWIN_WORK * n_values * factors.size, small.TWIN_LIMIT,
+                                                kernels, route=route):
+        twin = small.level_sums(kind, x, factors, bad, shift)
+        if twin is not None:
+            return twin.sums, twin.n_terms
+    return level_sums(kind, x, factors, bad, shift)
+
+
+#: Routes of :func:`avar._kernels.runtime.paths.numpy_path` (found compiled once, never asked again).
+_PHASE_ROUTE = "total.phase"
+_LEVEL_ROUTE = "total.levels"
+_THEO1_ROUTE = "total.theo1"
 
 
 def _ohvar1(x: np.ndarray, bad: np.ndarray, shift: int) -> tuple[float, int]:

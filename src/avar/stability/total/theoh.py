@@ -13,9 +13,10 @@ from typing import Any
 
 import numpy as np
 
+from avar._kernels.runtime.paths import numpy_path
 from avar._kernels.runtime.tasks import run_concurrently
-from avar._kernels.total.fft import autocorrelation
-from avar._kernels.total.theo1 import theo1_sums
+from avar._kernels.total.fft import HANKEL_KERNELS, autocorrelation
+from avar._kernels.total.theo1 import THEO1_KERNELS, theo1_sums
 from avar._kernels.total.theobr import oavar_sums
 from avar._kernels.total.windows import theo1_sum
 from avar.stability.classic.deviations import noise_exponents
@@ -23,12 +24,15 @@ from avar.stability.shared.deviation import Deviation
 from avar.stability.shared.grids import deviation_factors, total_factors
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE
 from avar.stability.shared.noise_types import check_alpha
+from avar.stability.total import small
 from avar.stability.total.deviations import prepared_phase
 from avar.stability.total.theobr import MIN_THEOBR_POINTS, theobr_factor
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES
 from avar.stability.uncertainty.edf import chi2_bounds, estimator_edf
 from avar.stability.uncertainty.total_edf import total_edf
 
+#: The route of :func:`avar._kernels.runtime.paths.numpy_path` for the displayed levels.
+_ROUTE = "total.theoh"
 #: Stable32's ThêoH table: OADEV at its own factors (m <= N / 4) and Theo1 from m = floor(N / THEO_FROM).
 THEO_FROM = 5
 
@@ -146,10 +150,17 @@ def theoh(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
     allan, theo = _levels(n_phase, rate, taus, k)
     unit = rate * rate if data_type == "phase" else 1.0
     no_gaps = np.zeros(0, dtype=np.int64)
-    (kf, _), sums, allan_sums = run_concurrently(  # kf and the displayed levels at the same time
-        lambda: theobr_factor(x, autocorr),
-        lambda: theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0).total, autocorr).sums,
-        lambda: oavar_sums(x, allan))
+    if numpy_path(lambda: small.theo1_work(n_phase, theo) // small.THEO1_UNITS + n_phase * allan.size,
+                  small.THEO1_LIMIT, THEO1_KERNELS + HANKEL_KERNELS + (oavar_sums,), route=_ROUTE):
+        # cold kernels: the displayed levels by the NumPy twins (kf still compiles its own)
+        kf = theobr_factor(x, autocorr).kf
+        sums = small.theo1_level_sums(x, theo, no_gaps, 0).sums
+        allan_sums = small.oavar_sums(x, allan)
+    else:
+        (kf, _), sums, allan_sums = run_concurrently(  # kf and the displayed levels at the same time
+            lambda: theobr_factor(x, autocorr),
+            lambda: theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0).total, autocorr).sums,
+            lambda: oavar_sums(x, allan))
     counts = n_phase - theo
     with np.errstate(over="ignore"):  # an overflow is an error below
         avar = allan_sums / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit

@@ -71,13 +71,29 @@ def decimated_alpha(x: np.ndarray, m: int, dmax: int, line: float) -> float:
     return np.nan
 
 
-def lag1_alphas(x: np.ndarray, factors: np.ndarray, dmax: int, line: float) -> np.ndarray:
+def with_drift(x: np.ndarray, drift: float) -> np.ndarray:
+    """``x + drift * k (k - 1) / 2`` (k = 0 .. N - 1), with one temporary rather than five (the
+    kernels add it point by point, with the same bits).
+
+    >>> with_drift(np.zeros(4), 2.0).tolist()
+    [0.0, 0.0, 2.0, 6.0]
+    """
+    seen = np.arange(-1.0, x.size - 1.0)  # k - 1
+    seen *= np.arange(x.size, dtype=np.float64)
+    seen *= 0.5 * drift  # exact halving: (p / 2) drift and p (drift / 2) round alike
+    seen += x
+    return seen
+
+
+def lag1_alphas(x: np.ndarray, factors: np.ndarray, dmax: int, line: float, drift: float = 0.0) -> np.ndarray:
     """:func:`decimated_alpha` (or its kernel) of every factor; ``x`` contiguous finite float64
-    phase, every factor leaving at least 3 decimated points."""
+    phase, every factor leaving at least 3 decimated points. ``drift``: ``x`` lacks ``drift * k (k - 1) / 2``
+    (a removed linear frequency drift), which the method sees (:func:`with_drift`; the kernels add it on the fly)."""
     if numpy_path(x.size, NUMPY_POINTS, lag1_kernels(factors.size)):
-        return np.array([decimated_alpha(x, m, int(dmax), line) for m in factors.tolist()], dtype=np.float64)
+        seen = with_drift(x, drift) if drift else x
+        return np.array([decimated_alpha(seen, m, int(dmax), line) for m in factors.tolist()], dtype=np.float64)
     found = np.empty(factors.size)
-    (lag1_levels_split if found.size > 1 else lag1_levels)(x, factors, int(dmax), float(line), found)
+    (lag1_levels_split if found.size > 1 else lag1_levels)(x, factors, int(dmax), float(line), found, float(drift))
     return found
 
 

@@ -269,8 +269,8 @@ def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line
     acf = (n - 1) // m >= MIN_ACF_POINTS
     alpha = np.full(m.size, np.nan)
     if acf.any():
-        seen = _with_drift(x, drift) if drift else x  # the drift is data
-        alpha[acf] = lag1_alphas(seen, m[acf], int(dmax), np.nan if line is None else float(line))
+        # the drift is data: the kernels add it back point by point
+        alpha[acf] = lag1_alphas(x, m[acf], int(dmax), np.nan if line is None else float(line), float(drift))
     if not acf.all():
         lazy: dict[int, np.ndarray] = {}
 
@@ -300,15 +300,6 @@ def _raw_phase_noise(x: np.ndarray, m: np.ndarray, dmax: int, drift: float, line
 
 def _triangular(k: np.ndarray) -> np.ndarray:
     return k * (k - 1.0) / 2.0
-
-
-def _with_drift(x: np.ndarray, drift: float) -> np.ndarray:
-    """``x + drift * _triangular(k)`` (k = 0 .. N - 1), the same bits, with one temporary rather than five."""
-    seen = np.arange(-1.0, x.size - 1.0)  # k - 1
-    seen *= np.arange(x.size, dtype=np.float64)
-    seen *= 0.5 * drift  # exact halving: (p / 2) drift and p (drift / 2) round alike
-    seen += x
-    return seen
 
 
 def lag1_alpha(z: np.ndarray, dmax: int) -> float:
