@@ -16,6 +16,10 @@ report (every term the data chose: Gauss-Markov and sinusoid terms too), for inf
 Prints the figures; asserts nothing (a benchmark, not a test). Run from the repository root::
 
     python benchmarks/bench_simulate_recheck.py [--hours 2] [--rate 200] [--replicates 20] [--real PATH]
+
+``--truth-seeds 40 [--sensors Gyroscope]`` instead counts, over 40 logs simulated from the
+"ieee" model itself (the truth known, not a fitted model), how often the report's 95 %
+intervals of N, B and K hold the simulated values (target 0.85 - 1.0 for N and K).
 """
 
 from __future__ import annotations
@@ -113,13 +117,51 @@ def coverage(report, replicates: int, title: str) -> None:
               f"(0.95 +- {spread:.3f} binomial sd; accepted 0.85 - 1.0): {verdict}")
 
 
+def truth_coverage(seeds: int, hours: float, rate: float, sensors: tuple[str, ...]) -> None:
+    """Coverage of the report's intervals of N, B and K over ``seeds`` logs simulated from the "ieee" model itself
+    (the truth known): the share of the draws whose interval (or bound) holds the simulated value."""
+    model = MODEL
+    rows = pd.DataFrame([{"Channel": axis, "Sensor": kind, "Term": p, "Process": p, "Status": "present", "Value": v,
+                          "Unit": UNITS[kind][p]} for kind in sensors for axis in AXES[kind]
+                         for p, v in model[kind].items()])
+    draws = []
+    started = time.perf_counter()
+    for seed in range(1, seeds + 1):
+        table = avar.noise_report(avar.simulate_log(rows, duration=f"{hours}h", rate=rate, seed=seed)).table
+        for kind in sensors:
+            for axis in AXES[kind]:
+                for process, truth in model[kind].items():
+                    row = table[(table["Channel"] == axis) & (table["Process"] == process)].iloc[0]
+                    if row["Status"] == "present":
+                        covered = row["Lower"] <= truth <= row["Upper"]
+                    elif row["Status"] == "bound":
+                        covered = truth <= row["Upper"]
+                    else:
+                        covered = False
+                    draws.append((kind, process, row["Status"], covered, row["Value"] / truth))
+    frame = pd.DataFrame(draws, columns=["Sensor", "Process", "Status", "Covered", "Ratio"])
+    print(f"\n[ieee] coverage of the 95 % intervals over {seeds} seeds of the known model "
+          f"({hours:g} h at {rate:g} Hz; {time.perf_counter() - started:.0f} s)")
+    for (kind, process), group in frame.groupby(["Sensor", "Process"], sort=False):
+        spread = math.sqrt(0.95 * 0.05 / len(group))
+        statuses = ", ".join(f"{s} {n}" for s, n in group["Status"].value_counts().items())
+        print(f"  {kind:<14}{process:<4}coverage {group['Covered'].mean():.3f} of {len(group)} draws "
+              f"(0.95 +- {spread:.3f}); median ratio {group['Ratio'].median():.3f}; {statuses}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--hours", type=float, default=2.0)
     parser.add_argument("--rate", type=float, default=200.0)
     parser.add_argument("--replicates", type=int, default=20)
     parser.add_argument("--real", type=Path, default=None, help="an .npz of /work/shared/realdata (optional)")
+    parser.add_argument("--truth-seeds", type=int, default=0,
+                        help="only the coverage of N, B, K over this many logs of the known ieee model (e.g. 40)")
+    parser.add_argument("--sensors", nargs="+", default=list(MODEL), choices=list(MODEL))
     args = parser.parse_args()
+    if args.truth_seeds:
+        truth_coverage(args.truth_seeds, args.hours, args.rate, tuple(args.sensors))
+        return
     for case in ("kalibr", "ieee"):
         with tempfile.TemporaryDirectory() as folder:
             log = simulate_then_report(Path(folder), case, args.hours, args.rate)

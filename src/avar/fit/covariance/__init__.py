@@ -19,7 +19,8 @@ algorithms share). Two algorithms evaluate it, on the same model description
 * :mod:`avar.fit.covariance.structure`: :func:`~avar.fit.covariance.structure.structure_covariance`,
   gamma_jk from the model's structure function and its second cumulative sums,
   the lags summed sparsely (to :data:`~avar.fit.covariance.structure.ACCURACY`) at any N,
-  flicker included (the noise report's sandwich intervals).
+  flicker included (the noise report's sandwich intervals), a Gauss-Markov term's second sums
+  from :mod:`avar.fit.covariance.markov` (a short table, then closed form).
 
 References
 ----------

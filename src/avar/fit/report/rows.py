@@ -18,7 +18,11 @@ SIN    sinusoid amplitude, f0      sqrt(2 c); shape * f                  u; Hz
 
 Intervals: the squared coefficient c with sampling variance v is a scaled
 chi-square with 2 c^2 / v degrees of freedom; shapes get a normal interval
-(on the log scale for a correlation time). A term left out of the model is
+(on the log scale for a correlation time). Where the selection kept one of
+bias instability B and random walk K and left the other out, the kept one's
+interval is the union of the selected model's and the encompassing model's
+(the two refitted together; :func:`~avar.fit.report.uncertainty.encompassing_scale`):
+the selection between them is uncertain too. A term left out of the model is
 ``absent``, except the three an engineer always needs (N, B, K): those are
 ``bound``, with the upper end of the enlarged model's interval of the report's
 confidence, worded everywhere by :func:`bound_words` (``one-sided 97.5 % upper
@@ -48,6 +52,7 @@ import pandas as pd
 
 from avar.fit.report.noise_terms import ACCEL, GYRO, TERM_NAMES, customary, to_si, unit_of
 from avar.fit.report.sensor_fit import SensorFit, term_bound
+from avar.fit.report.uncertainty import encompassing_scale
 from avar.fit.terms import POWER_LAWS
 
 __all__ = ["channel_rows", "minimum_row", "bound_words", "group_of", "BOUNDED", "ROW_COLUMNS", "IEEE_952",
@@ -141,6 +146,11 @@ def channel_rows(channel: str, kind: str | None, unit: str | None, fit: SensorFi
             k = by_kind[process][0]
             c = fit.components[k].scale
             low, high = _chi2_interval(c, fit.scale_variance(k), significance)
+            wider = encompassing_scale(fit, k)
+            if wider is not None:  # B or K without the other: the union with the encompassing model's interval
+                other = _chi2_interval(*wider, significance) if wider.scale > 1e-300 else \
+                    (0.0, _normal_quantile(significance) * math.sqrt(max(wider.variance, 0.0)))
+                low, high = min(low, other[0]), max(high, other[1])
             rows.append(_ieee_row(channel, kind, unit, process, "present",
                                   (convert(c, rate), convert(low, rate), convert(high, rate))))
         elif process in BOUNDED:

@@ -39,9 +39,7 @@ levels and an addition raises that share. Given the record's length, the
 long-tau terms (random walk, a long Gauss-Markov term, flicker) are chosen
 again before that, by their exact likelihood (:mod:`avar.fit.report.long_tau`).
 
-edf_j = (N - 2 m_j + 1) / m_j, the number of nearly independent differences
-of level j (Percival & Walden 2000, sec. 8.4); the parameters' covariance is
-the inverse Fisher information J' diag(edf / (2 nu^2)) J.
+edf_j = (N - 2 m_j + 1) / m_j, the nearly independent differences of level j (Percival & Walden 2000, 8.4).
 
 References
 ----------
@@ -55,6 +53,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -63,7 +62,7 @@ from avar.fit.report.sandwich import independent_levels, parameter_covariance
 from avar.fit.report.sensor_terms import KINDS, LINEAR, deviance, weight_edf
 from avar.fit.terms import Component, basis
 
-__all__ = ["SensorFit", "fit_sensor_model", "term_bound"]
+__all__ = ["SensorFit", "Enlarged", "fit_sensor_model", "enlarged_fit", "term_bound"]
 
 #: How many of each shaped term a model may hold.
 MAX_COPIES = {"AR1": 2, "SIN": 2}
@@ -81,22 +80,12 @@ SCAN_TOLERANCE = 1e-4
 class SensorFit:
     """The selected model of one channel and its uncertainty.
 
-    Attributes
-    ----------
-    components : tuple of Component
-        The selected terms, in :data:`KINDS` order (AR1 by correlation time).
-    covariance : ndarray
-        Covariance of (scales of every component, then the shapes of the shaped ones).
-    factors, nu_hat, edf : ndarray
-        The data: averaging factors, Allan variances and their degrees of freedom.
-    deviance, criterion : float
-        The fitted deviance and the penalized criterion that selected the model.
-    penalty : float
-        Penalty per parameter of the criterion.
-    levels : ndarray or None
-        Covariance of the Allan variance estimates under the selected model
-        (:func:`avar.fit.report.uncertainty.with_level_covariance`); None: independent levels of ``edf``
-        degrees of freedom.
+    ``components``: the selected terms, in :data:`KINDS` order (AR1 by correlation time); ``covariance``: of
+    (scales of every component, then the shapes of the shaped ones); ``factors``, ``nu_hat``, ``edf``: the data
+    (averaging factors, Allan variances, their degrees of freedom); ``deviance``, ``criterion``: the fitted
+    deviance and the penalized criterion that selected the model, of ``penalty`` per parameter; ``levels``: the
+    covariance of the Allan variance estimates under the selected model
+    (:func:`avar.fit.report.uncertainty.with_level_covariance`), None for independent levels of ``edf``.
     """
 
     components: tuple[Component, ...]
@@ -377,22 +366,34 @@ def fit_sensor_model(factors: np.ndarray, nu_hat: np.ndarray, edf: np.ndarray, *
                      penalty=penalty)
 
 
+class Enlarged(NamedTuple):
+    """The selected model with more linear terms refitted: ``components``, their ``covariance``, its ``deviance``."""
+    components: tuple[Component, ...]
+    covariance: np.ndarray
+    deviance: float
+
+
+def enlarged_fit(fit: SensorFit, kinds: tuple[str, ...]) -> Enlarged:
+    """The selected terms plus linear ``kinds``, scales refitted (non-negative maximum likelihood, shapes kept),
+    and the sandwich covariance of (scales, shapes) around ``fit.levels`` (a scale the fit zeroes is floored at
+    1e-300: the covariance at the boundary, where the added terms compete with the kept ones)."""
+    problem = _Problem(fit.factors, fit.nu_hat, weight_edf(fit.edf))
+    terms = [(c.kind, c.shape) for c in fit.components] + [(kind, None) for kind in kinds]
+    scales, value = problem.solve(terms)
+    floor = tuple(Component(k, max(float(c), 1e-300), s) for (k, s), c in zip(terms, scales))
+    levels = independent_levels(floor, fit.factors, fit.edf) if fit.levels is None else fit.levels
+    return Enlarged(floor, parameter_covariance(floor, fit.factors, weight_edf(fit.edf), levels), value)
+
+
 def term_bound(fit: SensorFit, kind: str, level: float = 0.95) -> float:
     """One-sided upper bound of the per-sample variance of a linear term the model left out.
 
-    The term is added to the selected model and the scales refitted (non-negative
-    maximum likelihood); the bound is c + z sqrt(Var c) with z the ``level``
-    normal quantile, from the Fisher information of the enlarged model.
+    The term is added to the selected model and the scales refitted (:func:`enlarged_fit`); the bound is
+    c + z sqrt(Var c) with z the ``level`` normal quantile, from the sandwich covariance of the enlarged model.
     """
     from scipy.special import ndtri  # the normal quantile (scipy.stats takes 0.5 s to import)
 
-    problem = _Problem(fit.factors, fit.nu_hat, weight_edf(fit.edf))
-    terms = [(c.kind, c.shape) for c in fit.components] + [(kind, None)]
-    scales, _ = problem.solve(terms)
-    components = [Component(k, max(float(c), 0.0), s) for (k, s), c in zip(terms, scales)]
-    floor = tuple(Component(c.kind, max(c.scale, 1e-300), c.shape) for c in components)
-    levels = independent_levels(floor, fit.factors, fit.edf) if fit.levels is None else fit.levels
-    covariance = parameter_covariance(floor, fit.factors, weight_edf(fit.edf), levels)
-    at = len(terms) - 1
-    spread = math.sqrt(max(float(covariance[at, at]), 0.0))
-    return components[at].scale + float(ndtri(level)) * spread
+    components, covariance, _ = enlarged_fit(fit, (kind,))
+    at = len(components) - 1
+    scale = components[at].scale if components[at].scale > 1e-300 else 0.0
+    return scale + float(ndtri(level)) * math.sqrt(max(float(covariance[at, at]), 0.0))

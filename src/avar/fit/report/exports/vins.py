@@ -42,8 +42,8 @@ WALK = ("discrete-time bias random walk: K * sqrt(rate) (integration_base.h adds
 KEYS = {
     "acc_n": (ACCEL, "WN", f"m/s^2, {WHITE}", "m/s^2/sqrt(Hz)"),
     "gyr_n": (GYRO, "WN", f"rad/s, {WHITE}", "rad/s/sqrt(Hz)"),
-    "acc_w": (ACCEL, "RW", f"m/s^2.5 (m/s^3/sqrt(Hz) * sqrt(Hz)), {WALK}", "m/s^3/sqrt(Hz)"),
-    "gyr_w": (GYRO, "RW", f"rad/s^1.5 (rad/s^2/sqrt(Hz) * sqrt(Hz)), {WALK}", "rad/s^2/sqrt(Hz)"),
+    "acc_w": (ACCEL, "RW", f"m/s^3 (m/s^3/sqrt(Hz) * sqrt(Hz)), {WALK}", "m/s^3/sqrt(Hz)"),
+    "gyr_w": (GYRO, "RW", f"rad/s^2 (rad/s^2/sqrt(Hz) * sqrt(Hz)), {WALK}", "rad/s^2/sqrt(Hz)"),
 }
 
 
