@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from avar.models import FN, RW, WN
+from tests._support.imu_logs import write_imu_csv
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 FREQ = 50.0
@@ -25,16 +25,7 @@ def run(*args: str) -> subprocess.CompletedProcess:
 @pytest.fixture(scope="module")
 def imu_file(tmp_path_factory):
     """A CSV log: time, three gyros in deg/s and three accelerometers in g, 1 hour at 50 Hz."""
-    n = int(3600 * FREQ)
-    gyro = WN.from_continuous(3e-3, FREQ) + FN.from_continuous(2e-3, FREQ) + RW.from_continuous(3e-4, FREQ)
-    accel = WN.from_continuous(2e-5, FREQ) + FN.from_continuous(1.5e-5, FREQ) + RW.from_continuous(2e-6, FREQ)
-    rng = np.random.default_rng(5)
-    columns = {"time": np.arange(n) / FREQ}
-    columns |= {f"g{a}": gyro.simulate(n, seed=rng) for a in "xyz"}
-    columns |= {f"a{a}": accel.simulate(n, seed=rng) for a in "xyz"}
-    path = tmp_path_factory.mktemp("log") / "imu.csv"
-    pd.DataFrame(columns).to_csv(path, index=False, float_format="%.10g")
-    return path
+    return write_imu_csv(tmp_path_factory.mktemp("log") / "imu.csv", 3600, FREQ, seed=5)
 
 
 def test_one_command_writes_yaml_figure_and_table(imu_file, tmp_path):

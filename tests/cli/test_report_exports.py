@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from avar.models import FN, RW, WN
+from tests._support.imu_logs import write_imu_csv
 
 RATE = 100.0
 
@@ -24,16 +24,7 @@ def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
 @pytest.fixture(scope="module")
 def log(tmp_path_factory):
     """A CSV log: three gyros (deg/s) and three accelerometers (g), 10 minutes at 100 Hz."""
-    n = int(600 * RATE)
-    gyro = WN.from_continuous(3e-3, RATE) + FN.from_continuous(2e-3, RATE) + RW.from_continuous(3e-4, RATE)
-    accel = WN.from_continuous(2e-5, RATE) + FN.from_continuous(1.5e-5, RATE) + RW.from_continuous(2e-6, RATE)
-    rng = np.random.default_rng(8)
-    columns = {"time": np.arange(n) / RATE}
-    columns |= {f"g{a}": gyro.simulate(n, seed=rng) for a in "xyz"}
-    columns |= {f"a{a}": accel.simulate(n, seed=rng) for a in "xyz"}
-    path = tmp_path_factory.mktemp("log") / "imu.csv"
-    pd.DataFrame(columns).to_csv(path, index=False, float_format="%.10g")
-    return path
+    return write_imu_csv(tmp_path_factory.mktemp("log") / "imu.csv", 600, RATE, seed=8)
 
 
 UNITS = ("--gyro-units", "deg/s", "--accel-units", "g")

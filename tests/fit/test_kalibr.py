@@ -11,27 +11,18 @@ import pytest
 import yaml
 
 import avar
-from avar.models import FN, RW, WN
+from avar.models import WN
+from tests._support.imu_logs import ACCEL_TRUTH, GYRO_TRUTH, imu_columns
 
 FREQ = 100.0
 N_SAMPLES = 360_000
 G0 = 9.80665
 DEG = math.pi / 180
-# gyro in deg/s, accel in g; each term dominates a decade or more of the hour
-GYRO = {"N": 3e-3, "B": 2e-3, "K": 3e-4}
-ACCEL = {"N": 2e-5, "B": 1.5e-5, "K": 2e-6}
-
-
-def model(truth):
-    return (WN.from_continuous(truth["N"], FREQ) + FN.from_continuous(truth["B"], FREQ)
-            + RW.from_continuous(truth["K"], FREQ))
 
 
 @pytest.fixture(scope="module")
 def recording():
-    rng = np.random.default_rng(21)
-    columns = {f"gyro_{a}": model(GYRO).simulate(N_SAMPLES, seed=rng) for a in "xyz"}
-    columns |= {f"acc_{a}": model(ACCEL).simulate(N_SAMPLES, seed=rng) for a in "xyz"}
+    columns = imu_columns(N_SAMPLES, FREQ, seed=21, gyro="gyro_{}", accel="acc_{}")  # deg/s, g
     return SimpleNamespace(columns=pd.DataFrame(columns), freq=FREQ, topic="/imu0/data", source="flight.bag")
 
 
@@ -45,10 +36,10 @@ def test_kalibr_yaml_holds_the_simulated_densities_in_si(report, tmp_path):
     fields = yaml.safe_load(path.read_text())
     assert list(fields) == ["gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
                             "accelerometer_random_walk", "rostopic", "update_rate"]
-    assert fields["gyroscope_noise_density"] == pytest.approx(GYRO["N"] * DEG, rel=0.03)
-    assert fields["gyroscope_random_walk"] == pytest.approx(GYRO["K"] * DEG, rel=0.15)
-    assert fields["accelerometer_noise_density"] == pytest.approx(ACCEL["N"] * G0, rel=0.03)
-    assert fields["accelerometer_random_walk"] == pytest.approx(ACCEL["K"] * G0, rel=0.15)
+    assert fields["gyroscope_noise_density"] == pytest.approx(GYRO_TRUTH["N"] * DEG, rel=0.03)
+    assert fields["gyroscope_random_walk"] == pytest.approx(GYRO_TRUTH["K"] * DEG, rel=0.15)
+    assert fields["accelerometer_noise_density"] == pytest.approx(ACCEL_TRUTH["N"] * G0, rel=0.03)
+    assert fields["accelerometer_random_walk"] == pytest.approx(ACCEL_TRUTH["K"] * G0, rel=0.15)
     assert fields["rostopic"] == "/imu0/data"
     assert fields["update_rate"] == 100.0
 

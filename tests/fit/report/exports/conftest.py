@@ -10,27 +10,18 @@ import pandas as pd
 import pytest
 
 import avar
-from avar.models import FN, RW, WN
+from avar.models import WN
+from tests._support.imu_logs import imu_columns
 
 RATE = 200.0
 N_SAMPLES = int(20 * 60 * RATE)
 DEG = math.pi / 180
 G0 = 9.80665
-# gyro in deg/s, accel in g (continuous-time N, B, K)
-GYRO = {"N": 3e-3, "B": 2e-3, "K": 3e-4}
-ACCEL = {"N": 2e-5, "B": 1.5e-5, "K": 2e-6}
-
-
-def _model(truth):
-    return (WN.from_continuous(truth["N"], RATE) + FN.from_continuous(truth["B"], RATE)
-            + RW.from_continuous(truth["K"], RATE))
 
 
 @pytest.fixture(scope="session")
 def imu_report():
-    rng = np.random.default_rng(21)
-    columns = {f"gyro_{a}": _model(GYRO).simulate(N_SAMPLES, seed=rng) for a in "xyz"}
-    columns |= {f"acc_{a}": _model(ACCEL).simulate(N_SAMPLES, seed=rng) for a in "xyz"}
+    columns = imu_columns(N_SAMPLES, RATE, seed=21, gyro="gyro_{}", accel="acc_{}")  # deg/s, g
     recording = SimpleNamespace(columns=pd.DataFrame(columns), freq=RATE, topic="/imu0/data", source="flight.bag")
     return avar.noise_report(recording, gyro_units="deg/s", accel_units="g")
 
