@@ -13,7 +13,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import pandas as pd
 
-from avar._kernels.classic.phase import scan
+from avar._kernels.classic.phase import Scanned, scan
 from avar._time_steps import rate_from_index
 from avar._validation import as_array, as_float64, check_freq, check_numeric_dtype, short_repr
 from avar.stability.shared.confidence import DEFAULT_CONFIDENCE
@@ -24,14 +24,9 @@ __all__ = ["DATA_TYPES", "DEFAULT_CONFIDENCE", "NAN_POLICIES", "SCALE_LIMIT", "T
 DATA_TYPES = ("freq", "phase")
 
 
-class Scan(NamedTuple):
-    """One pass over the data (:func:`avar._kernels.classic.phase.scan`)."""
-
-    n_missing: int
-    total: float
-    low: float
-    high: float
-    moment: float
+#: One pass over the data (:func:`avar._kernels.classic.phase.scan`): ``n_missing``, ``total``, ``low``,
+#: ``high``, ``moment``; the kernel's own record, under the name the stability layer uses.
+Scan = Scanned
 
 
 class CheckedData(NamedTuple):
@@ -67,7 +62,7 @@ def check_data(data: Any, data_type: str, nan_policy: str, weigh: bool = False,
     values = np.ascontiguousarray(as_float64(array), dtype=np.float64)
     if not values.flags.writeable:  # one compiled signature of the kernels
         values = values.copy()
-    scanned = Scan(*scan(values, weigh=weigh)) if values.size else Scan(0, 0.0, np.inf, -np.inf, np.nan)  # one pass
+    scanned = scan(values, weigh=weigh) if values.size else Scan(0, 0.0, np.inf, -np.inf, np.nan)  # one pass
     if (np.isinf(scanned.low) or np.isinf(scanned.high)) and scanned.n_missing < values.size:
         infinite = np.flatnonzero(np.isinf(values))
         raise ValueError(f"data has {infinite.size} infinite value(s), the first at index {infinite[0]}; "
@@ -126,7 +121,7 @@ def scaled(values: np.ndarray, scanned: Scan, weigh: bool) -> ScaledData:
         return ScaledData(values, scanned, 0)
     exponent = int(np.frexp(big)[1])
     values = np.ldexp(values, -exponent)
-    return ScaledData(values, Scan(*scan(values, weigh=weigh)), exponent)
+    return ScaledData(values, scan(values, weigh=weigh), exponent)
 
 
 #: Data below 2**-TINY_LIMIT in magnitude have variances at the bottom of float64 (about 1e-302 and less).
