@@ -21,7 +21,7 @@ its noise identification (:mod:`avar.stability.uncertainty.lag1`), the scan of t
 (:func:`avar._kernels.uncertainty.edf.greenhall_sums`), the Allan variance
 (:func:`avar.stability.allan.columns.numpy_columns`) and the total family's phase, MTOTDEV,
 TTOTDEV and HTOTDEV levels and Theo1 levels (:mod:`avar.stability.total.deviations`, twin
-:mod:`avar.stability.total.small`). Where a twin cannot certify its
+:mod:`avar.stability.total.small`; ThêoH's kf, :mod:`avar.stability.total.small_theobr`). Where a twin cannot certify its
 result (adversarial data), or cannot apply (gaps), the kernels run whatever this says.
 
 Forcing one path (the tests run the exactness tests on each): the environment variable

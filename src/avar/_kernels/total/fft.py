@@ -17,12 +17,14 @@ by about eps times the norms of the inputs, as an FFT convolution.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 from scipy import fft
 
 #: Leaf sizes of the recursion (5-smooth, so that every FFT size is fast).
-_LEAVES = (64, 72, 75, 80, 81, 90, 96, 100, 108, 120, 125, 128)
+LEAVES = (64, 72, 75, 80, 81, 90, 96, 100, 108, 120, 125, 128)
 
 
 def autocorrelation(x: np.ndarray) -> np.ndarray:
@@ -51,29 +53,41 @@ def short_autocorrelation(x: np.ndarray, count: int) -> np.ndarray:
     if 2 * block >= n:
         return autocorrelation(x)[:count]
     n_blocks = -(-n // block)
-    padded = np.zeros(n_blocks * block + size)
-    padded[:n] = x
-    windows = np.lib.stride_tricks.as_strided(padded, (n_blocks, size), (block * padded.itemsize, padded.itemsize),
+    extended = np.zeros(n_blocks * block + size)
+    extended[:n] = x
+    windows = np.lib.stride_tricks.as_strided(extended, (n_blocks, size), (block * extended.itemsize, extended.itemsize),
                                               writeable=False)
     heads = np.zeros((n_blocks, size))
-    heads[:, :block] = padded[: n_blocks * block].reshape(n_blocks, block)
+    heads[:, :block] = extended[: n_blocks * block].reshape(n_blocks, block)
     spectrum = fft.rfft(windows, axis=1) * np.conj(fft.rfft(heads, axis=1))
     return fft.irfft(spectrum, size, axis=1)[:, :count].sum(axis=0)
 
 
-def _blocks(count: int) -> tuple[int, int]:
-    """(leaf, length): length = leaf * 2**k >= count with the smallest such length."""
+class LeafBlocks(NamedTuple):
+    """The recursion's layout: ``length = leaf * 2**k`` samples in leaves of ``leaf``."""
+
+    leaf: int
+    length: int
+
+
+def leaf_blocks(count: int) -> LeafBlocks:
+    """The smallest ``length = leaf * 2**k >= count`` over the leaf sizes :data:`LEAVES`.
+
+    >>> leaf_blocks(1000)
+    LeafBlocks(leaf=125, length=1000)
+    """
     best = None
-    for leaf in _LEAVES:
+    for leaf in LEAVES:
         length = leaf
         while length < count:
             length *= 2
-        if best is None or length < best[1]:
-            best = (leaf, length)
+        if best is None or length < best.length:
+            best = LeafBlocks(leaf, length)
     return best
 
 
-def _padded(values: np.ndarray, length: int) -> np.ndarray:
+def padded(values: np.ndarray, length: int) -> np.ndarray:
+    """``values`` cut or padded with zeros to ``length``."""
     out = np.zeros(length)
     n = min(length, values.shape[0])
     out[:n] = values[:n]
@@ -96,9 +110,9 @@ def hankel_lower(y: np.ndarray, kappa: np.ndarray, count: int) -> np.ndarray:
     A node [s, s + S) adds, for g in its upper half, the products with every i of
     its lower half: a correlation of the reversed lower half of y with
     kappa[2s + S/2 .. 2s + 3S/2), of length S without wrapping into the outputs used."""
-    leaf, length = _blocks(count)
-    yy = _padded(y, length)
-    kk = _padded(kappa, 3 * length)
+    leaf, length = leaf_blocks(count)
+    yy = padded(y, length)
+    kk = padded(kappa, 3 * length)
     out = np.zeros(length)
     _hankel_leaves(yy, kk, out, leaf)
     size = 2 * leaf
@@ -127,9 +141,9 @@ def half_convolution(f: np.ndarray, g: np.ndarray, count: int) -> np.ndarray:
 
     A node [s, s + S) adds the full convolution of f over its lower half with g
     over its upper half (every a < b there) at m = 2s + S/2 .. 2s + 3S/2 - 2."""
-    leaf, length = _blocks(count)
-    ff = _padded(f, length)
-    gg = _padded(g, length)
+    leaf, length = leaf_blocks(count)
+    ff = padded(f, length)
+    gg = padded(g, length)
     out = np.zeros(3 * length)
     _half_leaves(ff, gg, out, leaf)
     size = 2 * leaf

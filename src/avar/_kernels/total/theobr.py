@@ -37,7 +37,14 @@ from avar._kernels.total.split import ExpandedSums
 _STEP = 0.25
 
 
-def exp_sum(largest: float) -> tuple[np.ndarray, np.ndarray]:
+class ExpSum(NamedTuple):
+    """Nodes ``t`` and weights ``w`` of an exponential sum (:func:`exp_sum`)."""
+
+    t: np.ndarray
+    w: np.ndarray
+
+
+def exp_sum(largest: float) -> ExpSum:
     """(t, w) with 1 / s = sum_r w_r exp(-t_r s) to ~5e-16 relative for 1 <= s <= ``largest``.
 
     The trapezoidal rule on 1 / s = integral of exp(u - s e^u) du, nodes u = ln t from
@@ -47,7 +54,7 @@ def exp_sum(largest: float) -> tuple[np.ndarray, np.ndarray]:
     u = np.arange(low, np.log(40.0) + _STEP, _STEP)
     t = np.exp(u)
     below = _STEP * np.exp(low - _STEP) / (1.0 - np.exp(-_STEP))
-    return np.concatenate(([0.0], t)), np.concatenate(([below], _STEP * t))
+    return ExpSum(np.concatenate(([0.0], t)), np.concatenate(([below], _STEP * t)))
 
 
 @njit(cache=True, nogil=True)

@@ -11,10 +11,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from avar._kernels.total.fft import autocorrelation
+from avar._kernels.runtime.paths import numpy_path
+from avar._kernels.total.fft import HANKEL_KERNELS, autocorrelation
 from avar._kernels.total.theo1 import split_sums
 from avar._kernels.total.theobr import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
 from avar._kernels.total.windows import theo1_sum
+from avar.stability.total import small_theobr
 
 #: Fewest phase points: the average needs n = floor(N / 6) - 3 >= 0 and Allan terms at m = 9 + 3n.
 MIN_THEOBR_POINTS = 19
@@ -47,8 +49,37 @@ def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> TheoBRFa
     ``x``: gap-free phase, N >= 19 points; ``autocorr``: its FFT autocorrelation, if at hand.
     The units cancel in the ratio.
     """
+    if x.shape[0] <= small_theobr.THEOBR_TWIN_LIMIT and numpy_path(x.shape[0], small_theobr.THEOBR_TWIN_LIMIT,
+                                                                   HANKEL_KERNELS, route=_TWIN_ROUTE):
+        terms = twin_terms(x, autocorr)  # cold kernels: NumPy, unless a sum needs summing again
+        if terms is not None:
+            return TheoBRFactor(float(np.mean(terms)), theobr_count(x.shape[0]))
     terms, n = theobr_terms(x, autocorr)
     return TheoBRFactor(float(np.mean(terms)), n)
+
+
+#: The route of :func:`avar._kernels.runtime.paths.numpy_path` for kf's NumPy twin.
+_TWIN_ROUTE = "theobr-factor"
+
+
+def twin_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> np.ndarray | None:
+    """:func:`theobr_terms`' terms by the NumPy twin (:mod:`avar.stability.total.small_theobr`), or
+    None where some expanded sum is too ill-conditioned for kf's tolerance (the kernels then sum it again)."""
+    n_points = x.shape[0]
+    n = theobr_count(n_points)
+    i = np.arange(n + 1, dtype=np.int64)
+    m_avar = 9 + 3 * i
+    m_theo = 12 + 4 * i
+    autocorr = autocorrelation(x) if autocorr is None else autocorr
+    diagonals = small_theobr.lag_diagonals(x, int(m_avar[-1]) + 1)
+    avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
+    avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
+    every = small_theobr.theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
+    theo = every.sums[m_theo] / (0.75 * (n_points - m_theo) * m_theo * m_theo)
+    terms = avar / theo
+    if _levels_to_redo(terms, avar_ratio, 0.5).size or _levels_to_redo(terms, every.ratios[m_theo], 0.5).size:
+        return None
+    return terms
 
 
 def theobr_count(n_points: int) -> int:

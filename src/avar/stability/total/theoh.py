@@ -152,7 +152,7 @@ def theoh(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
     no_gaps = np.zeros(0, dtype=np.int64)
     if numpy_path(lambda: small.theo1_work(n_phase, theo) // small.THEO1_UNITS + n_phase * allan.size,
                   small.THEO1_LIMIT, THEO1_KERNELS + HANKEL_KERNELS + (oavar_sums,), route=_ROUTE):
-        # cold kernels: the displayed levels by the NumPy twins (kf still compiles its own)
+        # cold kernels: the displayed levels by the NumPy twins (kf too, where its twin certifies it)
         kf = theobr_factor(x, autocorr).kf
         sums = small.theo1_level_sums(x, theo, no_gaps, 0).sums
         allan_sums = small.oavar_sums(x, allan)
