@@ -95,8 +95,9 @@ def write_files(folder: Path, n: int) -> dict[str, Path]:
     gyro = rng.standard_normal((rows, 3)) * 1e-3  # rad/s
     accel = rng.standard_normal((rows, 3)) * 1e-2 + [0.0, 0.0, 9.81]  # m/s^2
     data = np.column_stack([gyro, accel])
+    # the stamps with every digit they need (%.6g would round 1000.005 s to 1000 s: duplicate times)
     np.savetxt(log, np.column_stack([t, data]), delimiter=",", header="time,gx,gy,gz,ax,ay,az", comments="",
-               fmt="%.6g")
+               fmt=["%.3f"] + ["%.6g"] * 6)
     return {"series": series, "log": log}
 
 
