@@ -40,8 +40,8 @@ from avar.cli.common import (
 )
 from avar.cli.outputs import csv_text, plan_outputs, report
 
-__all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "check_bag_units", "compute_file",
-           "compute_files", "figure_of", "load", "run_many", "series_unit", "summary_of"]
+__all__ = ["SHOW_PROGRESS", "ReadOptions", "add_cluster_arguments", "allan_of", "capped_workers", "check_bag_units",
+           "compute_file", "compute_files", "figure_of", "load", "run_many", "series_unit", "summary_of"]
 
 #: The progress bar over the files: None shows it when stderr is a terminal; True/False force it.
 SHOW_PROGRESS: bool | None = None
@@ -331,12 +331,13 @@ def _check_files(paths: list[str]) -> None:
         seen.add(key)
 
 
-def _capped_workers(asked: int, files: int) -> int:
-    """``--workers`` capped by the number of files (one task each) and of cores; a note says so."""
+def capped_workers(asked: int, files: int, noun: str = "file") -> int:
+    """``--workers`` capped by the number of ``files`` (one task each, named ``noun``) and of cores;
+    a note on stderr says so."""
     cores = os.cpu_count() or 1
     workers = max(1, min(asked, files, cores))
     if workers < asked:
-        print(f"--workers {asked}: {files} file(s) on {cores} core(s); starting {workers} worker process(es)",
+        print(f"--workers {asked}: {files} {noun}(s) on {cores} core(s); starting {workers} worker process(es)",
               file=sys.stderr)
     return workers
 
@@ -356,7 +357,7 @@ def run_many(args: argparse.Namespace) -> int:
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=paths, force=args.force)
     _check_files(paths)
     if args.workers is not None:
-        args.workers = _capped_workers(args.workers, len(paths))
+        args.workers = capped_workers(args.workers, len(paths))
         # an interrupted run ends at once (os._exit): the cluster's semaphores are the system's to free
         if QUIET_TRACKER not in sys.warnoptions:
             sys.warnoptions.append(QUIET_TRACKER)  # passed on to the resource tracker process

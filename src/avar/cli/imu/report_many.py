@@ -14,14 +14,20 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from avar.cli.common import InputFileError, Progress, UsageError, printable
-from avar.cli.compute_many import CONNECT_TIMEOUT, DASK_MISSING, QUIET_TRACKER, check_bag_units, file_labels
+from avar.cli.compute_many import (
+    CONNECT_TIMEOUT,
+    DASK_MISSING,
+    QUIET_TRACKER,
+    capped_workers,
+    check_bag_units,
+    file_labels,
+)
 from avar.cli.outputs import csv_text, plan_outputs
 from avar.cli.outputs import report as print_outputs
 
@@ -161,12 +167,7 @@ def run_many(args: argparse.Namespace) -> int:
     plan = plan_outputs(csv=args.output, figure=args.plot, inputs=paths, force=args.force)
     options = ReportOptions.from_args(args)
     if args.workers is not None:
-        cores = os.cpu_count() or 1
-        workers = max(1, min(args.workers, len(paths), cores))
-        if workers < args.workers:
-            print(f"--workers {args.workers}: {len(paths)} log(s) on {cores} core(s); starting {workers} "
-                  "worker process(es)", file=sys.stderr)
-        args.workers = workers
+        args.workers = capped_workers(args.workers, len(paths), "log")
         if QUIET_TRACKER not in sys.warnoptions:
             sys.warnoptions.append(QUIET_TRACKER)
     progress = Progress()

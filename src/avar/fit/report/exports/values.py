@@ -146,8 +146,8 @@ def number(value: float) -> str:
 
     OpenCV's ``FileStorage`` (and ORB-SLAM3's ``isReal`` check) need a real number to look like one.
 
-    >>> number(200.0), number(1e-05), number(0.000123456789)
-    ('200.0', '1.0e-05', '0.000123456789')
+    >>> number(200.0), number(1e-05), number(0.00012345)
+    ('200.0', '1.0e-05', '0.00012345')
     """
     text = repr(float(value))
     if "." not in text and "e" in text:
