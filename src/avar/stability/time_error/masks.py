@@ -17,13 +17,31 @@ The masks included are those of the clocks' wander generation under constant tem
   (Tables 1, 3, 4, 5 of G.8262 (07/2010)); G.813 SEC option 1 and option 2 have the same
   limits (G.8262 took them over) and are listed under their own names too.
 
-Not yet included: G.812 (SSU types), G.823 and G.824 (network limits of E1 and T1
-interfaces); a user may build any mask with :class:`Mask` and :class:`MaskPiece`.
+and the network limits: the wander an interface may show (measured against an ideal
+reference, whatever the clocks before it), names ending in "network":
+
+* G.823 (03/2000) synchronization interfaces of the 2048 kbit/s hierarchy: PRC, SSU, SEC and
+  PDH (2048 kbit/s, 2048 kHz) outputs; G.824 (03/2000) DS1 (1544 kbit/s) synchronization
+  interface. The Recommendations' tables themselves were not found: the pieces here are
+  those that reproduce, to the printed digits, every value Semtech's ToPTrace utility tabulates
+  for each mask (from 1 s up; so these masks start at 1 s, not 0.1 s). Cross-checks: the PRC
+  pieces are G.811's (Tables 1 and 2) up to 10^4 s, and the SEC pieces are those of G.8261.
+* G.8261 (08/2013) SyncE option 1 network: Tables 4 and 5, as transcribed in the timetools
+  package; the same values as the G.823 SEC limit.
+
+Not included: G.812 (SSU and node clock types I to VI) wander generation: no printed copy of
+its tables was found, and a mask is only added from printed values. A user may build any mask
+with :class:`Mask` and :class:`MaskPiece`.
 
 References
 ----------
 ITU-T G.811 (1997), G.813 (2003), G.8262/Y.1362 (2010), G.8272/Y.1367 (2018): timing
-characteristics of PRC, SEC, EEC and PRTC clocks.
+characteristics of PRC, SEC, EEC and PRTC clocks. ITU-T G.8261/Y.1361 (08/2013): timing and
+synchronization aspects in packet networks (clause 9.2.1.1, network limits). ITU-T G.823 and
+G.824 (03/2000): the control of jitter and wander within digital networks based on the 2048 and
+1544 kbit/s hierarchies (clauses 6.2, network limits for wander at synchronization interfaces).
+R. Smiley, timetools 0.6.0 (2017), ``timetools/synchronization/compliance/ituTG8261/eecOption1/
+networkWander.py``. Semtech, ToPSync ToPTrace utility, ``Interface/Masks.cpp`` (2015).
 """
 
 from __future__ import annotations
@@ -115,6 +133,13 @@ _EEC1_TDEV = ((0.1, 25, {0: 3.2}), (25, 100, {0.5: 0.64}), (100, 1000, {0: 6.4})
 _EEC2_MTIE = ((0.1, 1, {0: 20.0}), (1, 10, {0.48: 20.0}), (10, 1000, {0: 60.0}))
 _EEC2_TDEV = ((0.1, 2.5, {-0.5: 3.2}), (2.5, 40, {0: 2.0}), (40, 1000, {0.5: 0.32}), (1000, 1e4, {0: 10.0}))
 
+_G8261 = "ITU-T G.8261/Y.1361 (08/2013), clause 9.2.1.1, "
+_VIA_TIMETOOLS = " (network limit; as transcribed in timetools 0.6.0; the same values as the G.823 SEC limit)"
+_VIA_SEMTECH = (" (network limit at the interface; from the values Semtech's ToPTrace utility tabulates for it, "
+                "Masks.cpp 2015, at every sampled tau from 1 s; the Recommendation's own table was not found)")
+_NETWORK_MTIE_TAIL = (2000, np.inf, {0.2: 433.0, 1: 0.01})        # ns, the same for PDH, SSU and SEC
+_NETWORK_TDEV_TAIL = (100, 1e6, {0: 58.0, 0.5: 1.2, 1: 3e-4})     # ns
+
 _ALL = (
     _mask("G.811 PRC MTIE", "mtie", "ITU-T G.811 (1997), Table 1", _US,
           (0.1, 1000, {1: 0.275e-3, 0: 0.025}), (1000, np.inf, {1: 1e-5, 0: 0.29})),
@@ -134,9 +159,35 @@ _ALL = (
     _mask("G.813 SEC option 1 TDEV", "tdev", "ITU-T G.813 (2003), option 1 (as G.8262 Table 3)", _NS, *_EEC1_TDEV),
     _mask("G.813 SEC option 2 MTIE", "mtie", "ITU-T G.813 (2003), option 2 (as G.8262 Table 4)", _NS, *_EEC2_MTIE),
     _mask("G.813 SEC option 2 TDEV", "tdev", "ITU-T G.813 (2003), option 2 (as G.8262 Table 5)", _NS, *_EEC2_TDEV),
+    _mask("G.8261 SyncE option 1 network MTIE", "mtie", _G8261 + "Table 4" + _VIA_TIMETOOLS, _NS,
+          (0.1, 2.5, {0: 250.0}), (2.5, 20, {1: 100.0}), (20, 2000, {0: 2000.0}), _NETWORK_MTIE_TAIL),
+    _mask("G.8261 SyncE option 1 network TDEV", "tdev", _G8261 + "Table 5" + _VIA_TIMETOOLS, _NS,
+          (0.1, 17.14, {0: 12.0}), (17.14, 100, {1: 0.7}), _NETWORK_TDEV_TAIL),
+    _mask("G.823 PRC network MTIE", "mtie", "ITU-T G.823 (03/2000), clause 6.2.1" + _VIA_SEMTECH, _US,
+          (1, 1000, {1: 0.275e-3, 0: 0.025}), (1000, np.inf, {1: 1e-5, 0: 0.29})),
+    _mask("G.823 PRC network TDEV", "tdev", "ITU-T G.823 (03/2000), clause 6.2.1" + _VIA_SEMTECH, _NS,
+          (1, 100, {0: 3.0}), (100, 1000, {1: 0.03}), (1000, 1e4, {0: 30.0}), (1e4, 1e6, {0: 27.0, 1: 3e-4})),
+    _mask("G.823 SSU network MTIE", "mtie", "ITU-T G.823 (03/2000), clause 6.2.2" + _VIA_SEMTECH, _NS,
+          (1, 2.5, {0: 25.0}), (2.5, 200, {1: 10.0}), (200, 2000, {0: 2000.0}), _NETWORK_MTIE_TAIL),
+    _mask("G.823 SSU network TDEV", "tdev", "ITU-T G.823 (03/2000), clause 6.2.2" + _VIA_SEMTECH, _NS,
+          (1, 4.3, {0: 3.0}), (4.3, 100, {1: 0.7}), _NETWORK_TDEV_TAIL),
+    _mask("G.823 SEC network MTIE", "mtie", "ITU-T G.823 (03/2000), clause 6.2.3" + _VIA_SEMTECH
+          + "; the same pieces as G.8261 Table 4", _NS,
+          (1, 2.5, {0: 250.0}), (2.5, 20, {1: 100.0}), (20, 2000, {0: 2000.0}), _NETWORK_MTIE_TAIL),
+    _mask("G.823 SEC network TDEV", "tdev", "ITU-T G.823 (03/2000), clause 6.2.3" + _VIA_SEMTECH
+          + "; the same pieces as G.8261 Table 5", _NS,
+          (1, 17.14, {0: 12.0}), (17.14, 100, {1: 0.7}), _NETWORK_TDEV_TAIL),
+    _mask("G.823 PDH network MTIE", "mtie", "ITU-T G.823 (03/2000), clause 6.2.4" + _VIA_SEMTECH, _NS,
+          (1, 7.3, {0: 732.0}), (7.3, 20, {1: 100.0}), (20, 2000, {0: 2000.0}), _NETWORK_MTIE_TAIL),
+    _mask("G.823 PDH network TDEV", "tdev", "ITU-T G.823 (03/2000), clause 6.2.4" + _VIA_SEMTECH, _NS,
+          (1, 48, {0: 34.0}), (48, 100, {1: 0.7}), _NETWORK_TDEV_TAIL),
+    _mask("G.824 DS1 network MTIE", "mtie", "ITU-T G.824 (03/2000), DS1 (1544 kbit/s) synchronization interface"
+          + _VIA_SEMTECH, _NS, (1, 280, {0: 300.0, 1: 2.5}), (280, np.inf, {0: 997.0, 1: 0.01})),
+    _mask("G.824 DS1 network TDEV", "tdev", "ITU-T G.824 (03/2000), DS1 (1544 kbit/s) synchronization interface"
+          + _VIA_SEMTECH, _NS, (1, 10, {0: 100.0}), (10, 1000, {0.5: 31.623})),
 )
 
-#: Every mask by name (constant temperature wander generation).
+#: Every mask by name: clocks' wander generation at constant temperature, and network limits at interfaces.
 MASKS = MappingProxyType({mask.name: mask for mask in _ALL})
 
 
