@@ -101,3 +101,36 @@ def test_a_true_random_walk_is_kept(seed):
     assert "RW" in found and "AR1" not in found, found
     assert report.table.set_index("Process").loc["RW", "Status"] == "present"
     assert report.curves["Fits"].mean() >= 0.9 and not report.warnings
+
+
+def _band_check(nu: np.ndarray, edf: np.ndarray):
+    """The fit check's share on a chi-square band of ``edf`` degrees of freedom about the curve ``nu``."""
+    from avar.fit.report.checks import fit_check
+    from avar.stability.uncertainty.edf import chi2_bounds
+
+    lower, upper = (np.asarray(b) for b in chi2_bounds(np.sqrt(nu), edf, 0.95))
+
+    def share(implied: np.ndarray) -> float:
+        return float(np.mean(fit_check("", np.arange(nu.size), np.sqrt(nu), lower, upper, np.sqrt(implied)).fits))
+
+    return share
+
+
+def test_a_missed_last_level_gets_the_term_the_likelihood_supports_and_no_other():
+    """A Gauss-Markov curve whose last two octaves rise (x sqrt(6), x 6: a random walk the criterion's
+    penalty of 12.7 does not admit) misses the last level; with the fit check the random walk joins,
+    its likelihood ratio above 2.71, and every level fits. A rise of x 1.5 seen through a band 500 times
+    too narrow misses too, but the likelihood does not support a term for it: the model stays."""
+    factors = 2 ** np.arange(19)
+    edf = (N_SAMPLES - 2 * factors + 1) / factors
+    base = exact(WHITE + gauss_markov(150.0, 3e-4), factors)
+    for rise, band_edf, joins in ((6.0, 2.0 * edf, True), (1.5, 1000.0 * edf, False)):
+        nu = base * np.where(factors == factors[-1], rise, np.where(factors == factors[-2], math.sqrt(rise), 1.0))
+        share = _band_check(nu, band_edf)
+        plain = fit_sensor_model(factors, nu, edf, n_samples=N_SAMPLES)
+        checked = fit_sensor_model(factors, nu, edf, n_samples=N_SAMPLES, check=share)
+        assert plain.kinds == ("WN", "AR1") and share(plain.implied()) == pytest.approx(18 / 19)
+        if joins:
+            assert checked.kinds == ("WN", "RW", "AR1") and share(checked.implied()) == 1.0
+        else:
+            assert checked.kinds == ("WN", "AR1") and share(checked.implied()) == pytest.approx(18 / 19)

@@ -21,7 +21,7 @@ import pandas as pd
 from avar._validation import as_series
 from avar._vocabulary import CONFIDENCE_95, check_rate, renamed, resolve_confidence
 from avar.fit.gmwm import octave_factors
-from avar.fit.report.checks import FIT_SHARE, data_warnings, fit_check, unit_warnings
+from avar.fit.report.checks import data_warnings, fit_check, unit_warnings
 from avar.fit.report.noise_terms import ACCEL, GYRO, check_unit
 from avar.fit.report.result import NoiseReport
 from avar.fit.report.rows import channel_rows, minimum_row
@@ -154,9 +154,10 @@ def fit_channel(av: AllanVariance, significance: float) -> FittedChannel:
     noise type of the fitted model's local slope (the power-law noise exponent
     alpha = -1 - d log AV / d log tau, rounded into -2..2). The long-tau terms (random walk, a long
     Gauss-Markov term, flicker) are chosen on the levels' exact likelihood for the record's length
-    (:mod:`avar.fit.report.long_tau`). When the selected model fits fewer than 90 % of
-    the levels, the selection is extended by the terms the data demand (``check`` of
-    :func:`~avar.fit.report.sensor_fit.fit_sensor_model`). The parameters'
+    (:mod:`avar.fit.report.long_tau`). When the selected model misses a level, the selection is made
+    again with the fit check (``check`` of :func:`~avar.fit.report.sensor_fit.fit_sensor_model`): a larger
+    long-tau model that fits more levels where a likelihood-ratio test supports it, and below 90 % of the
+    levels the terms the data demand. The parameters'
     covariance is the sandwich around the exact covariance of the
     maximal-overlap levels under the selected model
     (:func:`~avar.fit.report.uncertainty.with_level_covariance`); for a
@@ -172,7 +173,7 @@ def fit_channel(av: AllanVariance, significance: float) -> FittedChannel:
     def share(implied: np.ndarray) -> float:
         return float(np.mean(fit_check("", av.levels, adev, lower, upper, np.sqrt(implied)).fits))
 
-    if share(fit.implied(factors)) < FIT_SHARE:
+    if share(fit.implied(factors)) < 1.0:
         fit = fit_sensor_model(factors, nu_hat, counts / factors, check=share, n_samples=av.n)
         lower, upper, edf = _band(av, fit.implied(factors), significance)
     if av.type != "mo":  # the exact covariance is the maximal-overlap estimator's
