@@ -187,3 +187,30 @@ def test_a_huge_phase_ramp_keeps_the_digits_of_the_noise(estimator):
         variance, _ = deviation_levels(estimator, x, factors, "phase", 1.0)
     for m, v in zip(factors, variance):
         assert v == pytest.approx(exact_variance(estimator, x, int(m), "phase")[0], rel=1e-13), m
+
+
+@pytest.mark.parametrize("estimator", ["hdev", "ohdev", "mhdev"])
+def test_a_negligible_drift_is_kept_with_the_same_levels_and_noise(estimator):
+    """White FM's fitted drift (~1e-22 here) is kept on the public path (one TwoSum per value
+    less): the same variances (to rounding) and alphas as removing it; a drift that
+    dominates the data is still removed."""
+    from avar.stability.classic.core import deviation_levels_and_phase
+    from avar.stability.classic.deviations import noise_of_levels
+
+    y = np.random.default_rng(3).standard_normal(300_000) * 1e-11 + 2e-22 * np.arange(300_000)
+    scanned = scan(y, weigh=True)
+    assert phase_parts(y, "freq", estimator, scanned, True).drift == 0.0
+    assert phase_parts(y, "freq", estimator, scanned).drift != 0.0
+    factors = deviation_factors(estimator, y.size + 1)
+    kept = deviation_levels_and_phase(estimator, y, factors, "freq", 1.0, scanned)
+    hi, lo, scale, _, _, phase, drift, _ = phase_parts(y, "freq", estimator, scanned)
+    strides, first, last = term_ranges(estimator, y.size + 1, factors)
+    sums, _ = level_sums(hi, lo, KERNEL_CODES[estimator], factors, strides, first, last)
+    m = factors.astype(float)
+    modified = m * m if estimator == "mhdev" else 1.0
+    removed = sums / (6 * m * m * modified * (last - first)) / scale**2  # the drift removed
+    np.testing.assert_allclose(kept.variance, removed, rtol=1e-12)  # HDEV: by the pyramid
+    alpha = noise_of_levels(estimator, kept.phase, kept.drift, factors, kept.line)
+    np.testing.assert_array_equal(alpha, noise_of_levels(estimator, phase, drift, factors, None))
+    steep = y + 1e-9 * np.arange(y.size)
+    assert phase_parts(steep, "freq", estimator, scan(steep, weigh=True), True).drift != 0.0

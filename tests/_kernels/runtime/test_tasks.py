@@ -54,3 +54,30 @@ def test_run_tasks_calls_every_task_once():
 
     run_tasks(50, task)
     assert counts == [1] * 50
+
+
+def test_a_warm_call_of_two_tasks_runs_them_side_by_side():
+    """The first call of a task runs task 0 alone in the calling thread (a kernel compiles
+    there); later calls of the same task code start the helpers at once, so two tasks overlap
+    (each waits for the other to have started)."""
+    numba = pytest.importorskip("numba")
+    if numba.get_num_threads() < 2:
+        pytest.skip("one thread")
+    started = [threading.Event(), threading.Event()]
+    overlapped = []
+
+    def call() -> None:
+        for event in started:
+            event.clear()
+
+        def task(i: int) -> None:
+            started[i].set()
+            overlapped.append(started[1 - i].wait(timeout=1.0))
+
+        run_tasks(2, task)
+
+    call()
+    assert overlapped == [False, True]  # cold: task 0 alone, then task 1
+    overlapped.clear()
+    call()
+    assert sorted(overlapped) == [True, True]

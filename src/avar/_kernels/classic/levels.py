@@ -63,9 +63,8 @@ from avar._kernels.classic.sums import (
     FUSED_BLOCK,
     FUSED_MAX_LEVELS,
     contiguous_squares,
-    contiguous_third,
+    contiguous_third_squares,
     difference_kernels,
-    square_sum,
     squared_difference_sums,
 )
 from avar._kernels.dd import fast_sum
@@ -243,8 +242,7 @@ def _fast_task_sum(hi, lo, code, m, stride, first, last_term, buffer):
             if code == 0:
                 total += contiguous_squares(hi, lo, m, start, count, buffer)
             else:
-                contiguous_third(hi, lo, m, start, count, buffer)
-                total += square_sum(buffer, count)
+                total += contiguous_third_squares(hi, lo, m, start, count, buffer)
         else:
             for j in range(count):
                 b = (start + j) * stride

@@ -20,20 +20,18 @@ stored, and the noise identification costs no pass of its own. Levels with
 at most :data:`TAIL` clusters also hand back their cluster sums (Barnes's B1
 ratio needs the few decimated points).
 
-The lower levels go block by block (2**:data:`BLOCK_EXP` samples): a block's
-pyramid lives in two buffers of a block and each level carries its running
-state (:data:`STATE`) from block to block, so the workspace is some
-kilobytes plus one value per block, never O(N) fresh memory (whose first-touch
-page faults cost more than the arithmetic). A level's chunk goes array by
-array (:func:`_chunk_fast`: exact differences and pair sums elementwise, the
-phase as one running sum, the moments as vectorized plain sums) in pieces
-that stay in the L1 cache; a stretch's first clusters and short chunks go one
-cluster at a time (:func:`_chunk_body`, its plain twin, which the tests compare). A long series runs as two
-stretches on two threads, cut at a block boundary fixed by N: the bits do not
-depend on the thread count. The tests compare the sums with the general
-kernels of :mod:`avar._kernels.classic.levels` and with exact arithmetic, the
-moments with a NumPy transcription, and the noise identification with the
-plain two-pass kernel on the stored phase.
+The lower levels go block by block (2**:data:`BLOCK_EXP` samples): a block's pyramid
+lives in two buffers of a block and each level carries its running state (:data:`STATE`)
+from block to block: some kilobytes of workspace, never O(N) fresh memory (whose page
+faults cost more than the arithmetic). A level's chunk goes array by array
+(:func:`_chunk_fast`: exact differences and pair sums elementwise, the phase as four
+running sums side by side, the moments as vectorized plain sums) in pieces that stay in
+the L1 cache; a stretch's first clusters and short chunks go one cluster at a time
+(:func:`_chunk_body`, its plain twin, which the tests compare). A long series runs as two
+stretches on two threads, cut at a block boundary fixed by N: the bits do not depend on
+the thread count. The tests compare the sums with the general kernels of
+:mod:`avar._kernels.classic.levels` and with exact arithmetic, the moments with a NumPy
+transcription, and the noise identification with the plain two-pass kernel.
 """
 
 from __future__ import annotations
@@ -171,11 +169,28 @@ def _terms(hh, ll, count, order, v, d1, d2, d3, pair_hi, pair_lo):
 
 @njit(cache=True, nogil=True)
 def _running(v, count, z0, z):
-    """The phase after each value: ``z[j] = z0 + v[0] + ... + v[j]`` (plain, as :func:`_chunk_body`)."""
-    total = z0
-    for j in range(count):
-        total += v[j]
-        z[j] = total
+    """The phase after each value, ``z[j] = z0 + v[0] + ... + v[j]``: four running sums side
+    by side (one per quarter of the piece, each from 0: their additions overlap, where one
+    chain of ``count`` would wait on each), then each quarter shifted by ``z0`` and the
+    quarters before it. Equal to :func:`_chunk_body`'s single chain to rounding (the tests compare)."""
+    part = count // 4
+    a = b = c = d = 0.0
+    for j in range(part):
+        a += v[j]
+        b += v[part + j]
+        c += v[2 * part + j]
+        d += v[3 * part + j]
+        z[j], z[part + j], z[2 * part + j], z[3 * part + j] = a, b, c, d
+    for j in range(4 * part, count):
+        d += v[j]
+        z[j] = d
+    shift = z0
+    for lane in range(4):  # vectorized: an addition per value
+        stop = count if lane == 3 else (lane + 1) * part
+        end = z[stop - 1] if stop > lane * part else 0.0
+        for j in range(lane * part, stop):
+            z[j] += shift
+        shift += end
 
 
 @njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
@@ -392,12 +407,16 @@ def octave_moments(y, centre, slope, scale, order, n_levels, stats, tails):
     low = min(n_levels, block_exp)
     sides = 2 if n_blocks >= SPLIT_BLOCKS else 1
     cut = n_blocks // 2 if sides == 2 else n_blocks  # the right stretch starts at this block
-    z_cut = _phase_at(y, centre, slope, scale, cut << block_exp) if sides == 2 else 0.0
     states = np.zeros((2, max(low, 1), STATE))
-    _start_states(states, n, low, cut, block_exp, z_cut)
+    _start_states(states, n, low, cut, block_exp, 0.0)
     top_hi = np.empty(max(full, 1))
     top_lo = np.empty(max(full, 1))
-    run_tasks(sides, lambda side: _stretch(y, centre, slope, scale, order, 0 if side == 0 else cut,
-                                           cut if side == 0 else n_blocks, low, states[side], top_hi, top_lo, tails,
-                                           block_exp))
+
+    def stretch(side: int) -> None:
+        if side == 1:  # the phase where the right stretch starts, found on its own thread
+            states[1, :low, _Z] = _phase_at(y, centre, slope, scale, cut << block_exp)
+        _stretch(y, centre, slope, scale, order, 0 if side == 0 else cut, cut if side == 0 else n_blocks, low,
+                 states[side], top_hi, top_lo, tails, block_exp)
+
+    run_tasks(sides, stretch)
     _finish_moments(n, low, n_levels, sides, order, full, states, top_hi, top_lo, stats, tails)

@@ -161,9 +161,10 @@ def contiguous_squares(hi, lo, m, start, count, buffer):
 
 
 @njit(cache=True)
-def contiguous_third(hi, lo, m, start, count, buffer):
-    """Third differences ``S[b + 3m] - 3 S[b + 2m] + 3 S[b + m] - S[b]`` at ``b = start .. start + count - 1``
-    into ``buffer`` (vectorized; HDEV's and OHDEV's terms, and MDEV's of the running sum)."""
+def contiguous_third_squares(hi, lo, m, start, count, buffer):
+    """Sum of the squared third differences ``S[b + 3m] - 3 S[b + 2m] + 3 S[b + m] - S[b]`` at
+    ``b = start .. start + count - 1`` (vectorized; OHDEV's terms, and MDEV's of the running sum),
+    squared in the loop that forms them (``count`` at most ``buffer.shape[0]``)."""
     h0 = hi[start : start + count]
     h1 = hi[start + m : start + m + count]
     h2 = hi[start + 2 * m : start + 2 * m + count]
@@ -179,14 +180,8 @@ def contiguous_third(hi, lo, m, start, count, buffer):
         b1 = l1[j] - l0[j]
         b2 = l2[j] - l1[j]
         b3 = l3[j] - l2[j]
-        buffer[j] = ((a3 - a2) - (a2 - a1)) + np.float64((b3 - b2) - (b2 - b1))
-
-
-@njit(cache=True)
-def square_sum(buffer, count):
-    """``sum(buffer[:count] ** 2)``, squaring in place (vectorized)."""
-    for j in range(count):
-        buffer[j] = buffer[j] * buffer[j]
+        d = ((a3 - a2) - (a2 - a1)) + np.float64((b3 - b2) - (b2 - b1))
+        buffer[j] = d * d
     return fast_sum(buffer, count)
 
 

@@ -87,6 +87,12 @@ class _Call:
             raise self.error
 
 
+#: The code of the tasks whose first call ran (so compiled their kernels) in the calling thread:
+#: later calls start the helpers at once rather than after task 0 (else a call of two tasks
+#: runs them one after the other).
+_WARM: set = set()
+
+
 def run_tasks(n_tasks: int, task: Callable[[int], object]) -> None:
     """Call ``task(i)`` for ``i in range(n_tasks)``, each once, on up to :func:`threads` threads.
 
@@ -101,13 +107,19 @@ def run_tasks(n_tasks: int, task: Callable[[int], object]) -> None:
     n_tasks = int(n_tasks)
     if n_tasks <= 0:
         return
-    task(0)  # compiles the kernel, if it must, in the calling thread
-    helpers = min(threads(), n_tasks - 1) - 1
+    code = getattr(task, "__code__", None)
+    first = 0 if code in _WARM else 1  # warm: the helpers start at once (two tasks run side by side)
+    if first:
+        task(0)  # compiles the kernel, if it must, in the calling thread
+        if code is not None:
+            _WARM.add(code)
+    helpers = min(threads(), n_tasks - first) - 1
     if helpers <= 0:
-        for i in range(1, n_tasks):
+        for i in range(first, n_tasks):
             task(i)
         return
     call = _Call(n_tasks, task)
+    call.next = first
     _ensure_helpers(helpers)
     for _ in range(helpers):
         _JOBS.put(call.work)
