@@ -37,6 +37,7 @@ import subprocess
 import sys
 import tempfile
 import textwrap
+import time
 
 import numba
 import numpy as np
@@ -44,6 +45,7 @@ from timing import median_time  # benchmarks/timing.py
 
 import avar
 from avar._kernels.allan.blocks import plain_squares  # the library's plain float64 level sum
+from avar._kernels.allan.columns import run_sweep
 from avar.stability.shared.grids import averaging_factors
 
 try:
@@ -93,6 +95,24 @@ def plain_floor(x: np.ndarray, factors: np.ndarray, repeat: int) -> float:
         return median_time(lambda: _plain_floor_sums(cumulative, factors, 1 << 15), repeat)
 
 
+def former_small_levels(x: np.ndarray, factors: np.ndarray, repeat: int) -> tuple[float, float]:
+    """CPU seconds (median) of the octave "mo" kernels on ``x``: the small levels by moving sums
+    by pairs (the default), then by the former compensated sliding window (``window=True``),
+    alternating, in this process (CPU time: the machine may be shared)."""
+    data = x[:, None]
+    factors = np.asarray(factors, dtype=np.int64)
+    nd = x.size - 2 * factors + 1
+    times: dict[bool, list[float]] = {False: [], True: []}
+    for window in (False, True):
+        run_sweep(data, factors, nd, window=window)  # compile, page cache
+    for _ in range(repeat):
+        for window in (False, True):
+            start = time.process_time()
+            run_sweep(data, factors, nd, window=window)
+            times[window].append(time.process_time() - start)
+    return float(np.median(times[False])), float(np.median(times[True]))
+
+
 def allantools_call(x: np.ndarray, taus: np.ndarray, type: str):
     function = allantools.oadev if type == "mo" else allantools.adev
     return lambda: function(x, rate=1.0, data_type="freq", taus=taus)
@@ -121,7 +141,8 @@ print(elapsed, int(status["VmHWM"].split()[0]), x.nbytes)
 def peak_memory(n: int, dtype: str, type: str = "mo") -> tuple[float, float, float]:
     """(seconds, VmHWM MB, input MB) of a fresh process computing the octave AV of n samples."""
     code = textwrap.dedent(MEMORY.format(n=n, dtype=dtype, type=type))
-    warm = textwrap.dedent(MEMORY.format(n=300_000, dtype=dtype, type=type))  # fills numba's cache
+    # fills numba's cache for the long-record kernels too (above SMALL_MO_MAX = 2**22 samples)
+    warm = textwrap.dedent(MEMORY.format(n=1 << 23, dtype=dtype, type=type))
     subprocess.run([sys.executable, "-c", warm], capture_output=True, check=True)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     return float(out[0]), int(out[1]) / 1024, int(out[2]) / 1024**2
@@ -174,6 +195,7 @@ def main() -> None:
     rng = np.random.default_rng(0)
     times: dict[tuple[int, str], tuple[float, float | None, float]] = {}
     floor = None
+    former: dict[int, tuple[float, float]] = {}
     print("| case | avar.avar ms | allantools ms | speed-up | numpy cumsum ms | speed-up | numpy.sum ms | limit |")
     print("|---|---|---|---|---|---|---|---|")
     for exponent in range(3, args.max_exponent + 1):
@@ -194,11 +216,16 @@ def main() -> None:
             times[exponent, type] = (ours, at, sum_time)
             if n == 10**8 and type == "mo":
                 floor = plain_floor(x, factors, repeat)
+            if n >= 10**7 and type == "mo":
+                former[exponent] = former_small_levels(x, factors, repeat)
             print(
                 f"| N=1e{exponent} octave {type} | {fmt(ours)} | {fmt(at)} | {ratio(at, ours)} "
                 f"| {fmt(npy)} | {ratio(npy, ours)} | {fmt(sum_time)} | {sum_time / ours:.3f} |",
                 flush=True,
             )
+    for exponent, (pairs, window) in former.items():
+        print(f"N=1e{exponent} octave mo kernels, CPU time: small levels by moving sums by pairs {pairs * 1e3:.0f} ms, "
+              f"by the former compensated window {window * 1e3:.0f} ms ({window / pairs:.2f}x)")
     print()
     memory = {}
     for dtype in ("float64", "float32"):

@@ -39,6 +39,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
+from avar._kernels.allan.haar import exact_pair
 from avar._kernels.dd import EPS, fast_sum, fast_two_sum, two_sum
 from avar._kernels.runtime.tasks import run_tasks
 
@@ -129,22 +130,43 @@ def _centred_overload(x, c, sc):
     return impl
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _block_sum(data, col, start, stop, scale):
     """Compensated sum of ``data[start:stop, col] * scale`` and its least and largest value
-    (of the high parts, for 64-bit integers)."""
-    total = 0.0
-    comp = 0.0
-    low = np.inf
-    high = -np.inf
+    (of the high parts, for 64-bit integers), in four interleaved lanes: independent TwoSum
+    chains that the CPU overlaps (one chain waits for each addition; 1.9 against 1.25 ns a
+    sample), combined by TwoSum at the end."""
     x = data[start:stop, col]
-    for i in range(stop - start):
-        yh, yl = _centred(x[i], 0.0, scale)
-        low = min(low, yh)
-        high = max(high, yh)
-        total, e = two_sum(total, yh)
-        comp += e + yl
-    return total, comp, low, high
+    count = stop - start
+    t0 = t1 = t2 = t3 = c0 = c1 = c2 = c3 = 0.0
+    lo0 = lo1 = lo2 = lo3 = np.inf
+    hi0 = hi1 = hi2 = hi3 = -np.inf
+    for j in range(count // 4):
+        h0, l0 = exact_pair(x[4 * j], scale)
+        h1, l1 = exact_pair(x[4 * j + 1], scale)
+        h2, l2 = exact_pair(x[4 * j + 2], scale)
+        h3, l3 = exact_pair(x[4 * j + 3], scale)
+        t0, e0 = two_sum(t0, h0)
+        t1, e1 = two_sum(t1, h1)
+        t2, e2 = two_sum(t2, h2)
+        t3, e3 = two_sum(t3, h3)
+        c0 += e0 + l0
+        c1 += e1 + l1
+        c2 += e2 + l2
+        c3 += e3 + l3
+        lo0, lo1, lo2, lo3 = min(lo0, h0), min(lo1, h1), min(lo2, h2), min(lo3, h3)
+        hi0, hi1, hi2, hi3 = max(hi0, h0), max(hi1, h1), max(hi2, h2), max(hi3, h3)
+    for i in range(4 * (count // 4), count):
+        h0, l0 = exact_pair(x[i], scale)
+        t0, e0 = two_sum(t0, h0)
+        c0 += e0 + l0
+        lo0 = min(lo0, h0)
+        hi0 = max(hi0, h0)
+    a, ea = two_sum(t0, t1)
+    b, eb = two_sum(t2, t3)
+    total, e = two_sum(a, b)
+    return total, ((c0 + c1) + (c2 + c3)) + ((ea + eb) + e), min(min(lo0, lo1), min(lo2, lo3)), \
+        max(max(hi0, hi1), max(hi2, hi3))
 
 
 #: Samples summed per parallel task of :func:`block_table` (whole blocks).

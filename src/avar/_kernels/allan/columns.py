@@ -20,6 +20,7 @@ from avar._kernels.allan.far import FAR_SPAN, SWEEP_FINE, far_sums
 from avar._kernels.allan.haar import CHUNK_BLOCKS as HAAR_CHUNK
 from avar._kernels.allan.haar import HAAR_KERNEL, PYRAMID_EXP, haar_sums
 from avar._kernels.allan.levels import level_sums, to_task
+from avar._kernels.allan.pyramid import PYRAMID_BLOCK, PYRAMID_CHUNK, PYRAMID_NEAR, pyramid_sums
 from avar._kernels.allan.small import PARALLEL_KERNEL, small_allan_variance, small_allan_variance_parallel
 from avar._kernels.allan.sweep import SWEEP_BLOCK, SWEEP_CHUNK, SWEEP_NEAR, sweep_sums
 
@@ -32,8 +33,8 @@ SMALL_MAX = 1 << 15
 #: Octave-or-not "mo" series of at most this many samples (a 5.8 h log at 200 Hz) take the
 #: small path with the levels shared among the threads (16 bytes a sample of cumulative sum,
 #: and up to 8 bytes a sample per thread for a level that fails certification). Warm, the
-#: cache-blocked sweep is about twice as fast above 2**18 samples (17 ms against 33 ms for
-#: 1.44 M samples), but compiling the sweep, far and block-table kernels costs about 4 s more
+#: octave path (:func:`run_sweep`) was about twice as fast above 2**18 samples (17 ms against 33 ms for
+#: 1.44 M samples), but compiling its pyramid, far and block-table kernels costs about 4 s more
 #: on a cold cache than the small path: a typical log's first report would wait for them.
 SMALL_MO_MAX = 1 << 22
 
@@ -109,23 +110,34 @@ def run_haar(data, factors, n_diff, exp=PYRAMID_EXP, chunk=None):
     return out
 
 
-def run_sweep(data, factors, n_diff, block=SWEEP_BLOCK, near=SWEEP_NEAR, chunk=None, fine=SWEEP_FINE,
-              tol=CERTIFY_TOL, span=FAR_SPAN):
+def run_sweep(data, factors, n_diff, block=None, near=None, chunk=None, fine=SWEEP_FINE, tol=CERTIFY_TOL,
+              span=FAR_SPAN, window=False):
     """"mo" at power-of-two cluster sizes ``factors`` (increasing): the levels below ``near``
-    by the cache-blocked sweep (:mod:`avar._kernels.allan.sweep`), the others by residue class
+    by moving sums by pairs in blocks of ``block`` samples (:mod:`avar._kernels.allan.pyramid`;
+    ``window=True``: by the compensated sliding window of :mod:`avar._kernels.allan.sweep`, the
+    former path, with its own defaults), the others by residue class
     (:mod:`avar._kernels.allan.far`, table granularity ``fine``, certification tolerance ``tol``),
     in groups whose largest factor is at most ``span`` times their smallest (a task's ring
     of local prefixes holds ``2 span + 2`` pieces: 528 kB by default, whatever N); a last
     group of at most :data:`FAR_TAIL` levels joins the one before when the whole stays within
     ``FAR_TAIL_RATIO span`` (a ring of at most 2 MB)."""
     data = read_only(data)
+    if near is None:
+        near = SWEEP_NEAR if window else PYRAMID_NEAR
+    if block is None:
+        block = SWEEP_BLOCK if window else PYRAMID_BLOCK
     n_small = int(np.searchsorted(factors, near))
     fine = min(fine, int(factors[n_small])) if n_small < factors.shape[0] else fine
     th, tl, centre, scale, spread = _table(data, fine)
     sums = np.empty((data.shape[1], factors.shape[0]))
     if n_small > 0:
-        chunk = _chunk(n_diff[0], block, SWEEP_CHUNK) if chunk is None else chunk
-        sums[:, :n_small] = sweep_sums(data, centre, scale, factors[:n_small], n_diff[:n_small], block, chunk)
+        small, nd = factors[:n_small], n_diff[:n_small]
+        if window:
+            chunk = _chunk(n_diff[0], block, SWEEP_CHUNK) if chunk is None else chunk
+            sums[:, :n_small] = sweep_sums(data, centre, scale, small, nd, block, chunk)
+        else:
+            chunk = _chunk(n_diff[0], block, PYRAMID_CHUNK) if chunk is None else chunk
+            sums[:, :n_small] = pyramid_sums(data, centre, scale, small, nd, block, chunk, tol)
     start = n_small
     while start < factors.shape[0]:
         stop = int(np.searchsorted(factors, factors[start] * span, side="right"))

@@ -44,6 +44,7 @@ from numba import njit
 
 from avar._kernels.allan.blocks import CERTIFY_TOL, certified, prefix_squares
 from avar._kernels.allan.far_steps import exact_sums, table_base
+from avar._kernels.allan.pyramid import largest_magnitude
 from avar._kernels.dd import EPS
 from avar._kernels.runtime.tasks import run_tasks
 
@@ -58,33 +59,66 @@ SWEEP_FINE = 1 << 10
 FAR_SPAN = 1 << 5
 
 
-@njit(cache=True, inline="always")
+#: Samples per group of :func:`local_prefix`: their partial sums run apart from the carry.
+GROUP = 8
+
+
+@njit(cache=True)
 def local_prefix(rows, col, start, count, centre, sc, out):
     """``out[i] = sum_{s<i} (x[start+s] sc - centre)`` in plain float64 for ``i < count``
     (and ``i = count`` when ``out`` is longer: a last, short piece is read up to its end).
 
-    Returns ``B``, the largest ``|partial sum|``. Each stored value errs by at most
-    ``count u (r + B)`` with ``r >= |x sc - centre|`` over the piece: one rounding of
-    each centred sample and of each partial sum (:func:`difference_error_bound`).
+    Returns ``B``, the largest ``|out[i]|`` (NaN if one is not finite). Samples go in groups of
+    :data:`GROUP`: the group's own partial sums ``p_k`` (``k < GROUP``, independent of the
+    other groups), then ``out = carry + p_k`` and one addition to the carry per group, so the
+    CPU overlaps the groups (a plain running sum waits for every addition). The rounding
+    errors: :func:`prefix_error_bound` (``r >= |x sc - centre|`` over the piece).
     Not for 64-bit integers (not exact in one float64).
     """
     x = rows[col, start : start + count]
     o = out[:count]
-    total = 0.0
-    big = 0.0
-    for i in range(count):
-        o[i] = total
-        total += np.float64(x[i]) * sc - centre
-        big = max(big, abs(total))
+    carry = 0.0
+    for j in range(count // GROUP):  # GROUP = 8, written out: LLVM then keeps the group in registers
+        xs = x[GROUP * j : GROUP * j + GROUP]
+        og = o[GROUP * j : GROUP * j + GROUP]
+        p1 = np.float64(xs[0]) * sc - centre
+        p2 = p1 + (np.float64(xs[1]) * sc - centre)
+        p3 = p2 + (np.float64(xs[2]) * sc - centre)
+        p4 = p3 + (np.float64(xs[3]) * sc - centre)
+        p5 = p4 + (np.float64(xs[4]) * sc - centre)
+        p6 = p5 + (np.float64(xs[5]) * sc - centre)
+        p7 = p6 + (np.float64(xs[6]) * sc - centre)
+        p8 = p7 + (np.float64(xs[7]) * sc - centre)
+        og[0] = carry
+        og[1] = carry + p1
+        og[2] = carry + p2
+        og[3] = carry + p3
+        og[4] = carry + p4
+        og[5] = carry + p5
+        og[6] = carry + p6
+        og[7] = carry + p7
+        carry += p8
+    for i in range(GROUP * (count // GROUP), count):
+        o[i] = carry
+        carry += np.float64(x[i]) * sc - centre
     if count < out.shape[0]:
-        out[count] = total
-    return big
+        out[count] = carry
+    if not np.isfinite(carry):
+        return np.inf
+    return max(abs(carry), largest_magnitude(o))
 
 
 @njit(cache=True, inline="always")
 def prefix_error_bound(count, spread, big):
-    """Bound on the error of every value of :func:`local_prefix`: ``1.01 u count (r + B)``."""
-    return 1.01 * EPS * count * (spread + big)
+    """Bound on the error of every value of :func:`local_prefix`:
+    ``1.01 u (count + GROUP) (GROUP r + B)``.
+
+    Per group: the centring of its samples (``u r`` each), its partial sums (``GROUP - 1``
+    roundings of at most ``u GROUP r``) and one addition to the carry (``u B``): at most
+    ``u (GROUP r + B / GROUP)`` a sample; a stored value adds one rounding of at most ``u B``
+    and a part of its own group.
+    """
+    return 1.01 * EPS * (count + GROUP) * (GROUP * spread + big)
 
 
 @njit(cache=True, inline="always")
@@ -112,6 +146,8 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
     reach = 2 * (factors[n_levels - 1] // factors[0])  # farthest piece a level reads, in class steps
     ring = reach + 2  # the pieces a level reads, and the one filled ahead
     prefixes = np.empty((0 if wide else ring) * fine)  # slot s: [s fine, (s + 1) fine); 1-d, as every allocation
+    for s in range(0 if wide else ring):  # a piece starting at N is never filled; its prefix is S[N] - S[N] = 0
+        prefixes[s * fine] = 0.0
     errors = np.empty(ring)
     bigs = np.empty(ring)
     ready = 0  # class steps whose local prefix is in the ring

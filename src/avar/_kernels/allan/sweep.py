@@ -1,4 +1,8 @@
-"""Maximal-overlap Allan variance of power-of-two cluster sizes: the small levels' cache-blocked sweep (numba).
+"""Maximal-overlap Allan variance of power-of-two cluster sizes: the small levels' compensated sliding window (numba).
+
+The exact path of :mod:`avar._kernels.allan.pyramid` (the (block, level) pairs its plain moving
+sums cannot certify, and 64-bit integers), and its twin (``run_sweep(window=True)``): until
+the pyramid, every small octave level took this path.
 
 For a cluster size ``m`` the differences are ``D_t = S[t+2m] - 2 S[t+m] + S[t]``
 (``S`` the centred cumulative sum). The levels ``m < SWEEP_NEAR`` share one
