@@ -20,8 +20,10 @@ its noise identification (:mod:`avar.stability.uncertainty.lag1`), the scan of t
 (:func:`avar._kernels.classic.phase.scan`), Greenhall's EDF sums
 (:func:`avar._kernels.uncertainty.edf.greenhall_sums`), the Allan variance
 (:func:`avar.stability.allan.columns.numpy_columns`) and the total family's phase, MTOTDEV,
-TTOTDEV and HTOTDEV levels and Theo1 levels (:mod:`avar.stability.total.deviations`, twin
-:mod:`avar.stability.total.small`; ThêoH's kf, :mod:`avar.stability.total.small_theobr`). Where a twin cannot certify its
+TTOTDEV and HTOTDEV levels and Theo1 levels (:mod:`avar.stability.total.deviations`, twins
+:mod:`avar.stability.total.small` and :mod:`avar._kernels.total.theo1_numpy`; ThêoH's kf,
+:mod:`avar.stability.total.small_theobr`) and the dynamic deviations' phase and window sums
+(:mod:`avar.stability.dynamic.estimator`, twin :mod:`avar.stability.dynamic.small`). Where a twin cannot certify its
 result (adversarial data), or cannot apply (gaps), the kernels run whatever this says.
 
 Forcing one path (the tests run the exactness tests on each): the environment variable
@@ -156,7 +158,9 @@ def numpy_path(work: int | Callable[[], int], limit: int, kernels: tuple | Calla
     work = work() if callable(work) else work
     if work > limit:
         return False
-    key = tuple(id(entry[0] if isinstance(entry, tuple) else entry) for entry in kernels)
+    # the kernels themselves, not their id(): an id is reused once its object is collected, and a
+    # new kernel must not inherit a dead one's spent work
+    key = tuple(entry[0] if isinstance(entry, tuple) else entry for entry in kernels)
     spent = _SPENT.get(key, 0) + work + CALL_WORK
     if spent > HOT_WORK:
         return False  # hot: compile now, and be fast from here on
