@@ -177,3 +177,23 @@ def test_theobr_terms_of_random_walk_fm_equal_the_direct_ones(monkeypatch):
     terms, n = theo.theobr_terms(x)
     assert np.mean(terms) == pytest.approx(np.mean(avar / theo1), rel=1e-11)
     np.testing.assert_allclose(terms[:20], (avar / theo1)[:20], rtol=1e-10)  # the smallest m: split or direct
+
+
+def test_theo1s_own_kernels_on_the_threads_and_serially(monkeypatch):
+    """Theo1's direct loop (its own kernels, not MTOTDEV's): serially and in tasks on the threads
+    the same bits, the plain loop to 1e-12, and the terms touching a gap skipped."""
+    from avar._kernels.total import windows
+
+    x = noises(1500)["random-walk FM"]
+    missing = np.zeros(x.size, dtype=bool)
+    missing[[40, 41, 900]] = True
+    bad = np.concatenate(([0], np.cumsum(missing))).astype(np.int64)
+    for m in (2, 10, 64):
+        serial = theo1_sum(x, m, NO_GAPS, 0)
+        gapped = theo1_sum(x, m, bad, 0)
+        monkeypatch.setattr(windows, "PARALLEL_WORK", 0)
+        assert theo1_sum(x, m, NO_GAPS, 0) == serial and theo1_sum(x, m, bad, 0) == gapped
+        monkeypatch.undo()
+        assert serial.total == pytest.approx(plain_theo1(x, m), rel=1e-12)
+        assert serial.n_terms == x.size - m
+        assert gapped.n_terms == sum(not missing[i : i + m + 1].any() for i in range(x.size - m))

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import avar
+from avar._kernels.classic.phase import detrended_phase
 from avar._kernels.runtime.paths import forced
 from avar._kernels.total.blocks import BLOCK_KERNELS
 from avar._kernels.total.windows import DIRECT_KERNELS, level_sums
@@ -83,6 +84,26 @@ def test_twin_phase_is_the_kernels_bit_for_bit(data_type, estimator):
     assert np.array_equal(twin, phase_parts(data, data_type, estimator).hi)
 
 
+@pytest.mark.parametrize("data_type", ["freq", "phase"])
+def test_twin_phase_of_several_blocks_is_the_kernels_bit_for_bit(data_type):
+    """Blocks of 1000 increments (the kernel's second pass starts each from the earlier blocks'
+    total) and of the default size: the same bits as :func:`detrended_phase`."""
+    data = np.cumsum(np.cumsum(WHITE)) * 1e-6 + 7.0 if data_type == "phase" else WHITE * 1e-11 + 2e-9
+    kind = int(data_type == "phase")
+    line = phase_line(data, data_type, "oadev")
+    for block in (1000, 999, N):
+        hi = np.empty(N + 1 - kind)
+        lo = np.empty(N + 1 - kind, dtype=np.float32)
+        detrended_phase(line.filled, np.zeros(1, dtype=np.float32), kind, float(line.centre), line.slope, line.scale,
+                        hi, lo, block)
+        twin = small.twin_phase(line.filled, kind, line.centre, line.slope, line.scale, block)
+        assert np.array_equal(twin, hi)
+    long = np.concatenate([WHITE] * 40)[: 3 * (1 << 16) + 17] * 1e-3 + 1.0  # four default blocks
+    line = phase_line(long, "freq", "oadev")
+    assert np.array_equal(small.twin_phase(line.filled, 0, line.centre, line.slope, line.scale),
+                          phase_parts(long, "freq", "oadev").hi)
+
+
 @pytest.mark.parametrize("name", ["mtotdev", "ttotdev", "htotdev", "mhtotdev", "theo1", "theoh"])
 @pytest.mark.parametrize("data_type", ["freq", "phase"])
 @pytest.mark.parametrize("gaps", [False, True])
@@ -158,7 +179,7 @@ def test_auto_takes_the_twins_only_while_the_kernels_are_cold(monkeypatch):
         monkeypatch.setattr(paths, "_SPENT", {})
         cold = avar.mtotdev(WHITE), avar.theo1(WHITE)
         assert calls == ["levels", "theo1"]
-        avar.mtotdev(np.tile(WHITE, 30))  # 1.2e5 samples: beyond the twin's limit
+        avar.mtotdev(np.tile(WHITE, 60))  # 2.4e5 samples: beyond the twin's limit
         assert calls == ["levels", "theo1"]
     for a, b, c in zip(kernel, warm, cold):
         np.testing.assert_array_equal(a.variance, b.variance)

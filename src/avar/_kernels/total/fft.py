@@ -23,6 +23,11 @@ import numpy as np
 from numba import njit
 from scipy import fft
 
+from avar._kernels.runtime.paths import numpy_path
+from avar._kernels.total import theo1_numpy
+
+#: The route of :func:`avar._kernels.runtime.paths.numpy_path` for the Hankel leaves.
+_HANKEL_ROUTE = "total.hankel_leaves"
 #: Leaf sizes of the recursion (5-smooth, so that every FFT size is fast).
 LEAVES = (64, 72, 75, 80, 81, 90, 96, 100, 108, 120, 125, 128)
 
@@ -114,7 +119,10 @@ def hankel_lower(y: np.ndarray, kappa: np.ndarray, count: int) -> np.ndarray:
     yy = padded(y, length)
     kk = padded(kappa, 3 * length)
     out = np.zeros(length)
-    _hankel_leaves(yy, kk, out, leaf)
+    if numpy_path(length * leaf, theo1_numpy.HANKEL_LIMIT, (_hankel_leaves,), route=_HANKEL_ROUTE):
+        theo1_numpy.hankel_leaves(yy, kk, out, leaf)  # cold kernel: its NumPy twin, bit for bit
+    else:
+        _hankel_leaves(yy, kk, out, leaf)
     size = 2 * leaf
     while size <= length:
         half = size // 2

@@ -35,6 +35,8 @@ import numpy as np
 from numba import njit
 from scipy import fft
 
+from avar._kernels.runtime.paths import numpy_path
+from avar._kernels.total import theo1_numpy
 from avar._kernels.total.fft import autocorrelation, phi_sums, short_autocorrelation
 from avar._kernels.total.split import combine, groups, split_parts
 from avar._kernels.total.theobr import lag_diagonals, oavar_expanded, theo1_every
@@ -113,9 +115,12 @@ def _weighted_lags(long: np.ndarray, short: np.ndarray, m: int) -> tuple[float, 
     return first, second
 
 
-#: The compiled kernels of the expansion (a NumPy twin stands in for them and the direct loop
-#: while they are cold: :func:`avar.stability.total.small.theo1_level_sums`).
+#: The compiled kernels of the expansion (while they are cold, short records take a NumPy twin of
+#: the whole sum, :func:`avar.stability.total.small.theo1_level_sums`, and long ones these
+#: kernels' twins, :mod:`avar._kernels.total.theo1_numpy`).
 THEO1_KERNELS = (_plain_parts, _weighted_lags)
+#: The route of :func:`avar._kernels.runtime.paths.numpy_path` (found compiled once, never asked again).
+_ROUTE = "total.theo1_expanded"
 
 
 def _end_autocorrelation(x: np.ndarray, reverse: np.ndarray, k: int) -> np.ndarray:
@@ -140,8 +145,10 @@ def theo1_expanded(prepared: tuple, m: int) -> Expanded:
     terms (the square terms, or sum(x^2) sum w_a) to it: the result has about ``eps * ratio``
     relative error. ``prepared``: :func:`prepare` with h_max >= m / 2."""
     x, reverse, squares, autocorr, phi, phi_reverse = prepared
-    square, lags, ends = _plain_parts(x, reverse, squares, autocorr, phi, phi_reverse, m)
-    pairs, corners = _weighted_lags(_end_autocorrelation(x, reverse, m), _end_autocorrelation(x, reverse, m // 2), m)
+    cold = numpy_path(m, theo1_numpy.PARTS_LIMIT, THEO1_KERNELS, route=_ROUTE)  # NumPy's twins, bit for bit, while cold
+    parts, lags_of = (theo1_numpy.plain_parts, theo1_numpy.weighted_lags) if cold else (_plain_parts, _weighted_lags)
+    square, lags, ends = parts(x, reverse, squares, autocorr, phi, phi_reverse, m)
+    pairs, corners = lags_of(_end_autocorrelation(x, reverse, m), _end_autocorrelation(x, reverse, m // 2), m)
     total = square + 2.0 * lags + 2.0 * pairs - 2.0 * (ends + corners)
     weight = float(np.sum(1.0 / np.arange(1, m // 2 + 1)))
     ratio = max(square, weight * squares[-1]) / total if total > 0 else np.inf

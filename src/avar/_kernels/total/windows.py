@@ -19,7 +19,8 @@ that avoid the gaps. Smaller levels (where the expansion's ~1 ms of tables per
 level costs more) take the direct loop here: each window is detrended and
 summed through the running sum of its 9m-point reflected extension, read from
 the window's own running sum (one pass, no extension is built), so a window
-costs O(m) and a level O(N m). Theo1 always takes the direct loop here,
+costs O(m) and a level O(N m). Theo1 always takes the direct loop here (its own
+kernels, :func:`_theo1_serial`, so that Theo1 compiles none of MTOTDEV's loops),
 O(N m / 2) per level (:mod:`avar.stability.total.deviations` sends its long gap-free levels
 to :mod:`avar._kernels.total.theo1`). A level's terms run in tasks of
 :data:`CHUNK` terms whose sums are added in task order; large levels run the
@@ -133,30 +134,40 @@ CHUNK = 512
 @njit(cache=True, nogil=True)
 def _window_range(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, first: int,
                   last: int) -> tuple[float, int]:
-    """The terms ``first .. last - 1`` of one level (``kind`` 0 MTOTDEV on phase, 1 HTOTDEV on
-    frequency, 2 Theo1 on phase): their sum and how many avoid the gaps."""
+    """The windows ``first .. last - 1`` of one level (``kind`` 0 MTOTDEV on phase, 1 HTOTDEV on
+    frequency): their sum and how many avoid the gaps."""
     total = 0.0
     count = 0
     span = 3 * m
-    half = m // 2
     run = np.empty(span + 1)
     back = np.empty(span + 1)
     for start in range(first, last):
-        if kind == 2:
-            if not _clean(bad, shift, start, start + m + 1):
-                continue
-            acc = 0.0
-            for d in range(half):
-                t = (values[start] - values[start - d + half]) + (values[start + m] - values[start + d + half])
-                acc += t * t / (half - d)
-            total += acc
-        else:
-            if not _clean(bad, shift, start, start + span + kind):
-                continue
-            _detrended_running_sum(values, start, m, run)
-            for k in range(span + 1):
-                back[k] = run[span - k]
-            total += _reflected_terms(run, back, m) / (6.0 * m * m * m)
+        if not _clean(bad, shift, start, start + span + kind):
+            continue
+        _detrended_running_sum(values, start, m, run)
+        for k in range(span + 1):
+            back[k] = run[span - k]
+        total += _reflected_terms(run, back, m) / (6.0 * m * m * m)
+        count += 1
+    return total, count
+
+
+@njit(cache=True, nogil=True)
+def _theo1_range(values: np.ndarray, m: int, bad: np.ndarray, shift: int, first: int, last: int) -> tuple[float, int]:
+    """Theo1's outer terms ``first .. last - 1`` at factor ``m``: their sum and how many avoid the
+    gaps. Its own kernel (not a branch of :func:`_window_range`): a Theo1 call compiles only this
+    loop, not MTOTDEV's reflected windows."""
+    total = 0.0
+    count = 0
+    half = m // 2
+    for start in range(first, last):
+        if not _clean(bad, shift, start, start + m + 1):
+            continue
+        acc = 0.0
+        for d in range(half):
+            t = (values[start] - values[start - d + half]) + (values[start + m] - values[start + d + half])
+            acc += t * t / (half - d)
+        total += acc
         count += 1
     return total, count
 
@@ -184,8 +195,12 @@ def _level_threaded(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shif
     counts = np.zeros(n_tasks, dtype=np.int64)
 
     def tasks(first_task: int, stop_task: int) -> None:
-        sums[first_task:stop_task], counts[first_task:stop_task] = _task_range(
-            kind, values, m, bad, shift, n_terms, first_task, stop_task)
+        if kind == 2:
+            sums[first_task:stop_task], counts[first_task:stop_task] = _theo1_tasks(
+                values, m, bad, shift, n_terms, first_task, stop_task)
+        else:
+            sums[first_task:stop_task], counts[first_task:stop_task] = _task_range(
+                kind, values, m, bad, shift, n_terms, first_task, stop_task)
 
     run_ranges(n_tasks, tasks)
     total = 0.0
@@ -207,8 +222,37 @@ def _task_range(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: i
     return sums, counts
 
 
-#: The compiled kernels a direct level runs (serially: small levels).
+@njit(cache=True, nogil=True)
+def _theo1_serial(values: np.ndarray, m: int, bad: np.ndarray, shift: int, n_terms: int) -> tuple[float, int]:
+    """:func:`_level_serial` of Theo1 (its own kernel: compiles :func:`_theo1_range` only)."""
+    n_tasks = (n_terms + CHUNK - 1) // CHUNK
+    total = 0.0
+    count = 0
+    for task in range(n_tasks):
+        first = task * CHUNK
+        part, used = _theo1_range(values, m, bad, shift, first, min(n_terms, first + CHUNK))
+        total += part
+        count += used
+    return total, count
+
+
+@njit(cache=True, nogil=True)
+def _theo1_tasks(values: np.ndarray, m: int, bad: np.ndarray, shift: int, n_terms: int,
+                 first_task: int, stop_task: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_task_range` of Theo1."""
+    sums = np.zeros(stop_task - first_task)
+    counts = np.zeros(stop_task - first_task, dtype=np.int64)
+    for task in range(first_task, stop_task):
+        first = task * CHUNK
+        sums[task - first_task], counts[task - first_task] = _theo1_range(
+            values, m, bad, shift, first, min(n_terms, first + CHUNK))
+    return sums, counts
+
+
+#: The compiled kernels a direct MTOTDEV or HTOTDEV level runs (serially: small levels).
 DIRECT_KERNELS = (_level_serial,)
+#: The compiled kernels a direct Theo1 level runs (serially: small levels).
+THEO1_DIRECT_KERNELS = (_theo1_serial,)
 
 
 #: Levels with more window points than this (terms x window length) run on every thread.
@@ -236,6 +280,8 @@ def _level(kind: int, values: np.ndarray, m: int, bad: np.ndarray, shift: int, n
     work = n_terms * m * (1 if kind == 2 else 3)
     if work > PARALLEL_WORK and n_terms > CHUNK:
         return _level_threaded(kind, values, m, bad, shift, n_terms)
+    if kind == 2:
+        return _theo1_serial(values, m, bad, shift, n_terms)
     return _level_serial(kind, values, m, bad, shift, n_terms)
 
 

@@ -2,7 +2,9 @@
 
 :func:`dynamic` (any statistic of the classic family), :func:`dadev` (OADEV) and :func:`dhdev`
 (OHDEV). Validation happens here once; the windows' sums come from one pass over the record's
-terms per level (:mod:`avar._kernels.dynamic.windows`), so a window costs O(1) per level, and
+terms per level (:mod:`avar._kernels.dynamic.windows`; while that kernel and the phase's are cold
+and the work small, their NumPy twins in :mod:`avar.stability.dynamic.small`), so a window costs
+O(1) per level, and
 each window equals its statistic computed alone (the noise, EDF and bounds of every window are
 the public function's). TOTDEV, whose terms reflect the window's own ends, is computed window by
 window by the classic core.
@@ -15,11 +17,14 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from avar._kernels.classic.phase import PHASE_KERNELS
 from avar._kernels.dynamic.windows import window_sums
+from avar._kernels.runtime.paths import numpy_path
 from avar._kernels.runtime.tasks import run_tasks
 from avar._validation import short_repr
 from avar.stability.classic import deviations as classic
 from avar.stability.classic.core import HADAMARD, deviation_levels_and_phase, phase_parts, variance_of_sums
+from avar.stability.dynamic import small
 from avar.stability.dynamic.results import DynamicDeviation
 from avar.stability.shared.docstrings import PARAMETERS
 from avar.stability.shared.grids import grid_factors
@@ -36,6 +41,9 @@ DYNAMIC_STATISTICS = CLASSIC
 WINDOW_FRACTION = 4
 #: The smallest window (in samples): one level, m = 1.
 MIN_WINDOW = 4
+#: The routes of :func:`avar._kernels.runtime.paths.numpy_path` (found compiled once, never asked again).
+_WINDOW_ROUTE = "dynamic.window_sums"
+_PHASE_ROUTE = "dynamic.phase"
 
 
 class WindowLevels(NamedTuple):
@@ -106,7 +114,10 @@ def window_levels(statistic: str, values: np.ndarray, data_type: str, rate: floa
             levels = deviation_levels_and_phase(statistic, values[start:start + window], factors, data_type, rate)
             variance[w], counts[w] = levels.variance, levels.n_terms
         return WindowLevels(variance, counts)
-    hi, lo, scale, mode, bad, *_ = phase_parts(values, data_type, statistic, scanned)
+    if numpy_path(values.size, small.PHASE_LIMIT, PHASE_KERNELS, route=_PHASE_ROUTE):  # cold: NumPy, bit for bit
+        hi, lo, scale, mode, bad = small.twin_phase_parts(values, data_type, statistic, scanned)
+    else:
+        hi, lo, scale, mode, bad, *_ = phase_parts(values, data_type, statistic, scanned)
     bad = np.zeros(1, dtype=np.int64) if bad is None else np.ascontiguousarray(bad, dtype=np.int64)
     points = window + (data_type == "freq")
     full = term_counts(statistic, points, factors)
@@ -115,11 +126,17 @@ def window_levels(statistic: str, values: np.ndarray, data_type: str, rate: floa
     code = KERNEL_CODES[statistic]
     strided = statistic in ("adev", "hdev")
 
-    def level(i: int) -> None:  # nogil: the levels run on the threads, each into its own row
-        m = int(factors[i])
-        window_sums(hi, lo, code, m, m if strided else 1, starts, int(full[i]), mode, bad, sums[i], counts[i])
+    if numpy_path(lambda: small.twin_work(hi.shape[0], factors, n_windows, full), small.TWIN_LIMIT, (window_sums,),
+                  route=_WINDOW_ROUTE):  # cold kernel, small work: the NumPy twin (nothing to compile)
+        for i, m in enumerate(factors.tolist()):
+            sums[i], counts[i] = small.window_sums(hi, lo, code, m, m if strided else 1, starts, int(full[i]), mode,
+                                                   bad)
+    else:
+        def level(i: int) -> None:  # nogil: the levels run on the threads, each into its own row
+            m = int(factors[i])
+            window_sums(hi, lo, code, m, m if strided else 1, starts, int(full[i]), mode, bad, sums[i], counts[i])
 
-    run_tasks(n_levels, level)
+        run_tasks(n_levels, level)
     variance = variance_of_sums(statistic, sums.T, counts.T, factors[None, :], scale, data_type, rate)
     return WindowLevels(variance, np.ascontiguousarray(counts.T))
 

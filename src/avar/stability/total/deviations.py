@@ -19,11 +19,10 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from avar._kernels.classic.phase import PHASE_KERNELS
-from avar._kernels.classic.sums import CUMSUM_BLOCK
 from avar._kernels.runtime.paths import numpy_path
 from avar._kernels.total.fft import HANKEL_KERNELS, autocorrelation
 from avar._kernels.total.theo1 import THEO1_KERNELS, theo1_sums
-from avar._kernels.total.windows import DIRECT_KERNELS, level_sums, theo1_sum
+from avar._kernels.total.windows import THEO1_DIRECT_KERNELS, level_sums
 from avar.stability.classic.core import phase_line, phase_parts
 from avar.stability.classic.deviations import noise_exponents
 from avar.stability.shared.deviation import Deviation
@@ -110,8 +109,8 @@ def prepared_phase(estimator: str, data: Any, rate: Any, data_type: Any, confide
         raise ValueError(f"data has {values.size} sample(s); {estimator} of {data_type} data needs at least {needed}")
     kind = "ohdev" if estimator == "htotdev" else "oadev"
     n_increments = values.size - (data_type == "phase")
-    if numpy_path(n_increments, CUMSUM_BLOCK, PHASE_KERNELS, route=_PHASE_ROUTE):
-        # cold kernels, one block: the kernel's phase, bit for bit (:func:`avar.stability.total.small.twin_phase`)
+    if numpy_path(n_increments, small.PHASE_LIMIT, PHASE_KERNELS, route=_PHASE_ROUTE):
+        # cold kernels: the kernel's phase, bit for bit (:func:`avar.stability.total.small.twin_phase`)
         filled, bad, _, centre, slope, scale = phase_line(values, data_type, kind, scanned)
         x = small.twin_phase(filled, int(data_type == "phase"), centre, slope, scale)
     else:
@@ -128,10 +127,10 @@ def raw_variances(estimator: str, x: np.ndarray, factors: np.ndarray, bad: np.nd
     the FFT autocorrelation of gap-free ``x`` for Theo1, if at hand."""
     if estimator == "theo1" and autocorr is None and numpy_path(
             lambda: small.theo1_work(x.shape[0], factors) // small.THEO1_UNITS, small.THEO1_LIMIT,
-            THEO1_KERNELS + HANKEL_KERNELS + DIRECT_KERNELS, route=_THEO1_ROUTE):  # cold kernels: NumPy twin
+            THEO1_KERNELS + HANKEL_KERNELS + THEO1_DIRECT_KERNELS, route=_THEO1_ROUTE):  # cold kernels: NumPy twin
         sums, counts = small.theo1_level_sums(x, factors, bad, shift)
     elif estimator == "theo1" and bad.size == 0:  # long levels by FFT (exact to ~1e-11)
-        sums = theo1_sums(x, factors, lambda v, m: theo1_sum(v, m, bad, shift).total, autocorr).sums
+        sums = theo1_sums(x, factors, small.theo1_direct(bad, shift), autocorr).sums
         counts = x.shape[0] - factors
     else:  # HTOTDEV's m = 1 is OHDEV (below): its level is not summed
         first = int(estimator == "htotdev" and factors.size > 0 and factors[0] == 1)

@@ -7,11 +7,11 @@ the compensated phase (:func:`avar._kernels.classic.phase.detrended_phase`). Whi
 are cold and the record is short (:func:`avar._kernels.runtime.paths.numpy_path`, called by
 :mod:`avar.stability.total.deviations`), the twins here answer:
 
-* :func:`twin_phase`: the phase the kernels read, ``hi`` of the compensated running sum. For
-  at most :data:`avar._kernels.classic.sums.CUMSUM_BLOCK` increments the kernel's ``hi`` is the
-  plain sequential float64 sum of the increments' high parts (one block, started from 0), which
-  :func:`numpy.cumsum` reproduces bit for bit from the same exact pairs
-  (:func:`avar.stability.classic.small.increments`).
+* :func:`twin_phase`: the phase the kernels read, ``hi`` of the compensated running sum. Within
+  each block of :data:`avar._kernels.classic.sums.CUMSUM_BLOCK` increments the kernel's ``hi``
+  is the plain sequential float64 sum of the increments' high parts, started from the
+  sequential sum of the earlier blocks' totals, which :func:`numpy.cumsum` reproduces bit for
+  bit from the same exact pairs (:func:`avar.stability.classic.small.increments`).
 * :func:`level_sums`: MTOTDEV's and HTOTDEV's levels by the blocked expansion, the same blocks,
   tables and local detrending as the kernel (see :mod:`avar._kernels.total.blocks` for the
   formulas), vectorized over the blocks of one window count. Only the sliding moments are
@@ -34,12 +34,15 @@ terms that touch one, as the kernels do. The tests force each path on the same d
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
 
+from avar._kernels.classic.sums import CUMSUM_BLOCK
+from avar._kernels.runtime.paths import numpy_path
 from avar._kernels.total.blocks import BLOCK_KERNELS, block_size, blocks, level_tables
-from avar._kernels.total.windows import DIRECT_KERNELS, FAST_WORK
+from avar._kernels.total.windows import DIRECT_KERNELS, FAST_WORK, THEO1_DIRECT_KERNELS, theo1_sum
 from avar.stability.classic.small import increments
 
 #: Unit roundoff of float64.
@@ -48,12 +51,16 @@ EPS = 2.0**-53
 #: about 1e3 times the errors measured (random-walk FM at N = 1e4: estimates up to 7e-11, errors
 #: against the kernels up to 1.3e-13).
 TOL = 1e-10
-#: Work units (:data:`avar._kernels.runtime.paths.HOT_WORK`) charged per value and level: the
-#: twin spends 0.5 to 1 us per value and level (0.12 s at N = 1e4, 12 octave levels, on a loaded
-#: machine; the warm kernels 8 ms), 32 units of ~25 ns.
-TWIN_WORK = 32
-#: Largest work a call sends to the twin (N ~ 7e4 at octave taus: under a second, against ~2.5 s
-#: of compilation).
+#: Work units (:data:`avar._kernels.runtime.paths.HOT_WORK`) charged per value and level: a whole
+#: call on the twins spends 0.4 to 0.8 us per value and level (CPU, loaded machine: 0.08 s at N =
+#: 1e4, 12 octave levels; 0.66 s at N = 1e5, 16 levels; the warm kernels 8 and 60 ms), 16 units
+#: of ~25 ns (the per-value cost falls as N grows: NumPy's per-operation overhead is amortized).
+TWIN_WORK = 16
+#: Largest record whose phase :func:`twin_phase` forms while the phase kernels are cold (a few
+#: NumPy passes: ~10 ms per 1e6 values; the kernels' compilation ~0.5 s).
+PHASE_LIMIT = 1 << 21
+#: Largest work a call sends to the twin (N ~ 1.3e5 at octave taus: under a second, against 2.5
+#: to 5 s of compilation at N = 1e5).
 TWIN_LIMIT = 1 << 25
 #: A bound's safety factor over eps * (sum of magnitudes): the sums' lengths enter as their
 #: logarithm (NumPy's pairwise sums) or as a few units (dot products of block rows).
@@ -67,17 +74,28 @@ class TwinLevelSums(NamedTuple):
     n_terms: np.ndarray
 
 
-def twin_phase(data: np.ndarray, kind: int, centre: float, slope: float, scale: float) -> np.ndarray:
-    """The compiled ``hi`` of :func:`avar._kernels.classic.phase.detrended_phase` (one block):
+def twin_phase(data: np.ndarray, kind: int, centre: float, slope: float, scale: float,
+               block: int = CUMSUM_BLOCK) -> np.ndarray:
+    """The compiled ``hi`` of :func:`avar._kernels.classic.phase.detrended_phase`, bit for bit:
     0, then the running sum of the high parts of the increments less ``centre + slope i``, times
-    ``scale``. ``kind`` 0: ``data`` is the frequency, 1: the phase.
+    ``scale``. ``kind`` 0: ``data`` is the frequency, 1: the phase. The kernel sums ``block``
+    increments at a time: block b's ``hi`` is the sequential float64 sum of its high parts
+    started from the sequential sum of the earlier blocks' totals (each block's own sum from 0),
+    which :func:`numpy.cumsum` reproduces (its ``lo``, which the total family does not read, is
+    not formed).
 
     >>> twin_phase(np.array([1.0, 3.0, 2.0]), 0, 2.0, 0.0, 1.0).tolist()
     [0.0, -1.0, 0.0, 0.0]
     """
     high = increments(data, kind, centre, slope, scale).high
     phase = np.zeros(high.shape[0] + 1)
-    np.cumsum(high, out=phase[1:])
+    offset = 0.0
+    for start in range(0, high.shape[0], block):
+        part = high[start : start + block]
+        own = np.cumsum(part)  # the block's own sum from 0 (the kernel's first pass)
+        # the second pass: the block from the earlier blocks' total, cumsum of (offset, part)
+        phase[start + 1 : start + 1 + part.shape[0]] = np.cumsum(np.concatenate(([offset], part)))[1:] if start else own
+        offset += float(own[-1])
     return phase
 
 
@@ -269,11 +287,33 @@ def theo1_level_sums(x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift:
     return TwinLevelSums(sums, counts)
 
 
+#: The route of :func:`avar._kernels.runtime.paths.numpy_path` for Theo1's direct levels.
+_THEO1_DIRECT_ROUTE = "total.theo1_direct"
 #: Theo1's terms per work unit of :func:`avar._kernels.runtime.paths.numpy_path`: the twin
 #: spends ~3.5 ns per term (0.13 s at N = 1e4, octave levels), a unit stands for ~25 ns.
 THEO1_UNITS = 8
 #: Largest charged work a call sends to Theo1's twin (~0.5 s: N ~ 2e4 at octave taus).
 THEO1_LIMIT = 1 << 24
+
+
+def theo1_direct(bad: np.ndarray, shift: int) -> Callable[[np.ndarray, int], float]:
+    """Theo1's direct double sum of one level, ``direct(x, m)`` for
+    :func:`avar._kernels.total.theo1.theo1_sums`: by :func:`theo1_level_sums` while the direct
+    kernel is cold and the level small (:data:`THEO1_LIMIT`), else by
+    :func:`avar._kernels.total.windows.theo1_sum`.
+
+    >>> x = np.array([0.0, 1.0, 0.0, 2.0, 0.0, 1.0])
+    >>> theo1_direct(np.zeros(0, dtype=np.int64), 0)(x, 2)
+    38.0
+    """
+
+    def direct(x: np.ndarray, m: int) -> float:
+        if numpy_path(lambda: theo1_work(x.shape[0], np.array([m])) // THEO1_UNITS, THEO1_LIMIT, THEO1_DIRECT_KERNELS,
+                      route=_THEO1_DIRECT_ROUTE):
+            return float(theo1_level_sums(x, np.array([m]), bad, shift).sums[0])
+        return theo1_sum(x, m, bad, shift).total
+
+    return direct
 
 
 def theo1_work(n_points: int, factors: np.ndarray) -> int:

@@ -18,7 +18,7 @@ from avar._kernels.runtime.tasks import run_concurrently
 from avar._kernels.total.fft import HANKEL_KERNELS, autocorrelation
 from avar._kernels.total.theo1 import THEO1_KERNELS, theo1_sums
 from avar._kernels.total.theobr import oavar_sums
-from avar._kernels.total.windows import theo1_sum
+from avar._kernels.total.windows import THEO1_DIRECT_KERNELS
 from avar.stability.classic.deviations import noise_exponents
 from avar.stability.shared.deviation import Deviation
 from avar.stability.shared.grids import deviation_factors, total_factors
@@ -151,7 +151,8 @@ def theoh(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
     unit = rate * rate if data_type == "phase" else 1.0
     no_gaps = np.zeros(0, dtype=np.int64)
     if numpy_path(lambda: small.theo1_work(n_phase, theo) // small.THEO1_UNITS + n_phase * allan.size,
-                  small.THEO1_LIMIT, THEO1_KERNELS + HANKEL_KERNELS + (oavar_sums,), route=_ROUTE):
+                  small.THEO1_LIMIT, THEO1_KERNELS + HANKEL_KERNELS + THEO1_DIRECT_KERNELS + (oavar_sums,),
+                  route=_ROUTE):
         # cold kernels: the displayed levels by the NumPy twins (kf too, where its twin certifies it)
         kf = theobr_factor(x, autocorr).kf
         sums = small.theo1_level_sums(x, theo, no_gaps, 0).sums
@@ -159,7 +160,7 @@ def theoh(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
     else:
         (kf, _), sums, allan_sums = run_concurrently(  # kf and the displayed levels at the same time
             lambda: theobr_factor(x, autocorr),
-            lambda: theo1_sums(x, theo, lambda v, m: theo1_sum(v, m, no_gaps, 0).total, autocorr).sums,
+            lambda: theo1_sums(x, theo, small.theo1_direct(no_gaps, 0), autocorr).sums,
             lambda: oavar_sums(x, allan))
     counts = n_phase - theo
     with np.errstate(over="ignore"):  # an overflow is an error below
