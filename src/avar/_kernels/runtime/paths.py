@@ -23,7 +23,11 @@ its noise identification (:mod:`avar.stability.uncertainty.lag1`), the scan of t
 TTOTDEV and HTOTDEV levels and Theo1 levels (:mod:`avar.stability.total.deviations`, twins
 :mod:`avar.stability.total.small` and :mod:`avar._kernels.total.theo1_numpy`; ThêoH's kf,
 :mod:`avar.stability.total.small_theobr`) and the dynamic deviations' phase and window sums
-(:mod:`avar.stability.dynamic.estimator`, twin :mod:`avar.stability.dynamic.small`). Where a twin cannot certify its
+(:mod:`avar.stability.dynamic.estimator`, twin :mod:`avar.stability.dynamic.small`), the time-error
+levels of MTIE, TIE rms, PDEV and GCODEV (:mod:`avar.stability.time_error.deviations`, twin
+:mod:`avar.stability.time_error.small`) and the robust Allan variance's running median, outlier
+and square kernels (:mod:`avar.stability.robust.estimator`, twin :mod:`avar.stability.robust.small`).
+Where a twin cannot certify its
 result (adversarial data), or cannot apply (gaps), the kernels run whatever this says.
 
 Forcing one path (the tests run the exactness tests on each): the environment variable

@@ -15,12 +15,12 @@ from typing import Any
 
 import numpy as np
 
-from avar import _kernels
 from avar._validation import as_series, check_real
 from avar.imu import IMU
 from avar.stability.allan.columns import allan_variance_columns
 from avar.stability.allan.intervals import relative_errors
 from avar.stability.robust.results import Outliers, RobustAllanVariance
+from avar.stability.robust.small import outlier_kernels, squares_kernel
 from avar.stability.shared.grids import averaging_factors
 from avar.stability.shared.term_counts import n_differences
 
@@ -118,18 +118,17 @@ def flag_outliers(values: np.ndarray, threshold: float) -> Outliers:
     The two preliminary scales (s_med and the first s) read every k-th
     sample, at most about ``PRELIMINARY_SAMPLES`` (relative error ~0.3 %).
     """
-    n = values.size
-    flagged = np.zeros(n, dtype=bool)
-    residuals = np.empty(n)
-    _kernels.interpolation_residuals(values, flagged, residuals)
+    n, kernels = values.size, outlier_kernels(values)  # the compiled loops, or their NumPy twins while cold
+    flagged, residuals = np.zeros(n, dtype=bool), np.empty(n)
+    kernels.interpolation_residuals(values, flagged, residuals)
     scale = robust_scale(_every_kth(residuals))
     median = np.empty(n)
-    _kernels.running_median(values, MEDIAN_HALF_WIDTH, median)
+    kernels.running_median(values, MEDIAN_HALF_WIDTH, median)
     departure = values - median
     candidates = np.abs(departure) > threshold / 2 * min(robust_scale(_every_kth(departure)), scale)
     for final in (False, True):
         flagged = candidates.copy()
-        _kernels.release_candidates(values, flagged, residuals, threshold * scale, MAX_PASSES)
+        kernels.release_candidates(values, flagged, residuals, threshold * scale, MAX_PASSES)
         if not final and not flagged.all():
             scale = robust_scale(residuals[~flagged])
     indices = np.flatnonzero(flagged)
@@ -381,7 +380,7 @@ def robust_allan_variance(x: Any, rate: float | None = None, taus: Any = "octave
             centred -= centred.mean()
             for j in np.flatnonzero(intact):
                 m = int(factors[j])
-                squares, used = _kernels.intact_squares(centred, ~keep, m)
+                squares, used = squares_kernel(centred)(centred, ~keep, m)
                 with np.errstate(over="ignore"):  # reported below
                     allan[j] = np.ldexp(squares / (2.0 * m * m * used), 2 * exponent)
             if not np.isfinite(allan[intact]).all():

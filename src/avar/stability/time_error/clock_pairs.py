@@ -15,12 +15,11 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from avar._kernels.time_error import codev_levels
 from avar.stability.shared.deviation import Deviation
 from avar.stability.shared.grids import grid_factors
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE, check_data, check_options
 from avar.stability.shared.noise_types import check_alpha
-from avar.stability.time_error.deviations import level_noise, prepared_phase
+from avar.stability.time_error.deviations import level_kernel, level_noise, prepared_phase
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES, chi2_bounds
 
 #: Statistics the three-cornered hat accepts (variances of one clock that add over independent clocks).
@@ -187,7 +186,7 @@ def gcodev(data_1: Any, data_2: Any, rate: float | None = None, data_type: str =
                                    f"with {n_phase} phase points)")
     x1, gaps, extra = prepared_phase(first, data_type, rate)
     x2, _, _ = prepared_phase(second, data_type, rate)
-    sums, n = codev_levels(x1, x2, factors, gaps, extra)
+    sums, n = level_kernel("gcodev", x1, factors)(x1, x2, factors, gaps, extra)
     keep = n > 0
     if not keep.any():
         raise ValueError("no gcodev term avoids the NaN values of data_1 and data_2 at these taus")

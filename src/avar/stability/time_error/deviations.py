@@ -5,16 +5,19 @@ points, tau0 = 1 / rate, m the averaging factor, tau = m tau0; frequency data
 y convert to x = (0, cumsum(y - mean y)) tau0 as ``allantools``). Every level
 costs O(N) (:mod:`avar._kernels.time_error`); the levels are those with at
 least one term. ``alpha=`` fixes the noise exponent of every level instead of
-identifying it (as Stable32 allows).
+identifying it (as Stable32 allows). While a kernel is cold and the record short, its NumPy
+twin answers (:func:`level_kernel`, :mod:`avar.stability.time_error.small`): nothing to compile.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from avar._kernels.time_error import mtie_levels, pdev_levels, tierms_levels
+from avar._kernels import time_error as kernels
+from avar._kernels.runtime.paths import numpy_path
 from avar.stability.classic.deviations import noise_exponents, noise_of_levels
 from avar.stability.shared.deviation import Deviation
 from avar.stability.shared.docstrings import fill_parameters
@@ -22,6 +25,7 @@ from avar.stability.shared.grids import grid_factors, largest_factor
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE, check_data, check_not_tiny, check_options
 from avar.stability.shared.noise_types import ALPHA_PARAMETER, check_alpha
 from avar.stability.shared.term_counts import levels_with_terms
+from avar.stability.time_error import small
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES
 from avar.stability.uncertainty.edf import chi2_bounds, estimator_edf, gap_scaled_edf
 
@@ -70,19 +74,21 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
                            context=f"of {statistic} (averaging factors 1..{largest} at rate = {rate:g} Hz "
                                    f"with {n_phase} phase points)")
     phase, gaps, extra = prepared_phase(values, data_type, rate)
+    if statistic == "pdev":
+        phase = _line_free(phase, gaps, extra)
+    levels = level_kernel(statistic, phase, factors)
     if statistic == "mtie":
         # a window with a gap is skipped, so the filled values never reach a result
-        deviation, n = mtie_levels(phase, factors, gaps, extra)
+        deviation, n = levels(phase, factors, gaps, extra)
         with np.errstate(over="ignore"):  # an overflow is an error below
             variance = deviation**2
     else:
         if statistic == "pdev":
-            phase = _line_free(phase, gaps, extra)
-            sums, n = pdev_levels(phase, factors, gaps, extra)
+            sums, n = levels(phase, factors, gaps, extra)
             m = factors.astype(np.float64)
             scale = np.where(factors == 1, 2.0, m**4 / 72.0)
         else:
-            sums, n = tierms_levels(phase, factors, gaps, extra)
+            sums, n = levels(phase, factors, gaps, extra)
             m, scale = factors.astype(np.float64), 1.0
             if data_type == "freq":  # m = N: the one term spans the mean-removed data, zero by construction
                 sums = np.where((factors == n_phase - 1) & (n > 0), 0.0, sums)
@@ -106,6 +112,24 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         alpha=alpha_levels, edf=edf, lci=lci, uci=uci, estimator=statistic, data_type=data_type, rate=rate,
         n_samples=values.size, confidence=float(confidence),
     )
+
+
+def level_kernel(statistic: str, phase: np.ndarray, factors: np.ndarray) -> Callable:
+    """The levels' loop of ``statistic`` (``"mtie"``, ``"tierms"``, ``"pdev"`` or ``"gcodev"``): the
+    compiled kernel of :mod:`avar._kernels.time_error`, or its NumPy twin
+    (:mod:`avar.stability.time_error.small`: same arguments, same results) while the kernel is cold
+    and the work (phase points times levels) small (:func:`avar._kernels.runtime.paths.numpy_path`).
+
+    >>> from avar._kernels.runtime.paths import forced
+    >>> with forced("numpy"):
+    ...     level_kernel("mtie", np.zeros(4), np.array([1])).__module__
+    'avar.stability.time_error.small'
+    """
+    kernel = getattr(kernels, f"{statistic.replace('gcodev', 'codev')}_levels")
+    if numpy_path(small.TWIN_WORK[statistic] * phase.size * factors.size, small.TWIN_LIMIT, (kernel,), phase,
+                  route=f"time_error.{statistic}"):
+        return getattr(small, kernel.__name__)
+    return kernel
 
 
 def level_noise(fixed: int | None, values: np.ndarray, phase: np.ndarray, gaps: np.ndarray, data_type: str,
