@@ -12,7 +12,8 @@ and ``S`` the cumulative sum of the centred series (see :mod:`allan`). The
 full ``S`` (12 bytes a sample) is never stored:
 
 1. one pass sums every block of ``BLOCK`` samples (compensated, exact for
-   64-bit integers, which are split as ``hi * 2**32 + lo``) and finds the
+   64-bit integers, which are split as ``hi * 2**32 + lo``; plain float32 sums
+   where provably exact: :mod:`avar._kernels.allan.tablesums`) and finds the
    largest magnitude; an exact double-double scan of the block sums gives the
    centred ``S`` at every block boundary (the *table*, N / BLOCK entries);
 2. "to": one more pass. Each time block rebuilds its ``S`` values in a small
@@ -39,7 +40,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from avar._kernels.allan.haar import exact_pair
+from avar._kernels.allan.tablesums import block_sum, float32_table_task
 from avar._kernels.dd import EPS, fast_sum, fast_two_sum, two_sum
 from avar._kernels.runtime.tasks import run_tasks
 
@@ -130,45 +131,6 @@ def _centred_overload(x, c, sc):
     return impl
 
 
-@njit(cache=True)
-def _block_sum(data, col, start, stop, scale):
-    """Compensated sum of ``data[start:stop, col] * scale`` and its least and largest value
-    (of the high parts, for 64-bit integers), in four interleaved lanes: independent TwoSum
-    chains that the CPU overlaps (one chain waits for each addition; 1.9 against 1.25 ns a
-    sample), combined by TwoSum at the end."""
-    x = data[start:stop, col]
-    count = stop - start
-    t0 = t1 = t2 = t3 = c0 = c1 = c2 = c3 = 0.0
-    lo0 = lo1 = lo2 = lo3 = np.inf
-    hi0 = hi1 = hi2 = hi3 = -np.inf
-    for j in range(count // 4):
-        h0, l0 = exact_pair(x[4 * j], scale)
-        h1, l1 = exact_pair(x[4 * j + 1], scale)
-        h2, l2 = exact_pair(x[4 * j + 2], scale)
-        h3, l3 = exact_pair(x[4 * j + 3], scale)
-        t0, e0 = two_sum(t0, h0)
-        t1, e1 = two_sum(t1, h1)
-        t2, e2 = two_sum(t2, h2)
-        t3, e3 = two_sum(t3, h3)
-        c0 += e0 + l0
-        c1 += e1 + l1
-        c2 += e2 + l2
-        c3 += e3 + l3
-        lo0, lo1, lo2, lo3 = min(lo0, h0), min(lo1, h1), min(lo2, h2), min(lo3, h3)
-        hi0, hi1, hi2, hi3 = max(hi0, h0), max(hi1, h1), max(hi2, h2), max(hi3, h3)
-    for i in range(4 * (count // 4), count):
-        h0, l0 = exact_pair(x[i], scale)
-        t0, e0 = two_sum(t0, h0)
-        c0 += e0 + l0
-        lo0 = min(lo0, h0)
-        hi0 = max(hi0, h0)
-    a, ea = two_sum(t0, t1)
-    b, eb = two_sum(t2, t3)
-    total, e = two_sum(a, b)
-    return total, ((c0 + c1) + (c2 + c3)) + ((ea + eb) + e), min(min(lo0, lo1), min(lo2, lo3)), \
-        max(max(hi0, hi1), max(hi2, hi3))
-
-
 #: Samples summed per parallel task of :func:`block_table` (whole blocks).
 TABLE_TASK = 1 << 16
 
@@ -177,12 +139,12 @@ TABLE_TASK = 1 << 16
 def table_task(data, col, b0, b1, block, scale, ph, pl, low, high):
     """Blocks ``b0 .. b1 - 1`` of column ``col``: ``ph, pl[col, b]`` the double-double sum of
     ``data * scale`` over blocks ``b0 .. b`` (each block's sum compensated), and every block's
-    least and largest value (of the high parts, for 64-bit integers)."""
+    least and largest value (of the high parts, for 64-bit integers): :func:`avar._kernels.allan.tablesums.block_sum`."""
     n = data.shape[0]
     h = 0.0
     lo = 0.0
     for b in range(b0, b1):
-        total, comp, low[col, b], high[col, b] = _block_sum(data, col, b * block, min(n, (b + 1) * block), scale)
+        total, comp, low[col, b], high[col, b] = block_sum(data, col, b * block, min(n, (b + 1) * block), scale)
         s, e = two_sum(h, total)
         e += lo + comp
         h, lo = fast_two_sum(s, e)
@@ -208,9 +170,14 @@ def block_table(data, scale, integral, block=BLOCK):
     n_tasks = -(-nb // per_task)
     ph, pl, low, high = (np.empty((channels, nb)) for _ in range(4))
 
+    bits = data.T.view(np.int32) if data.dtype == np.float32 and np.all(scale == 1.0) else None  # plain where exact
+
     def task(t):
         c, j = divmod(t, n_tasks)
-        table_task(data, c, j * per_task, min(nb, (j + 1) * per_task), block, scale[c], ph, pl, low, high)
+        if bits is not None:
+            float32_table_task(data, data.T, bits, c, j * per_task, min(nb, (j + 1) * per_task), block, ph, pl, low, high)
+        else:
+            table_task(data, c, j * per_task, min(nb, (j + 1) * per_task), block, scale[c], ph, pl, low, high)
 
     run_tasks(channels * n_tasks, task)
     with np.errstate(all="ignore"):  # non-finite data: NaN or inf sums, which the caller reports
