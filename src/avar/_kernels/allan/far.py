@@ -44,7 +44,7 @@ from numba import njit
 
 from avar._kernels.allan.blocks import CERTIFY_TOL, certified, prefix_squares
 from avar._kernels.allan.far_steps import exact_sums, table_base
-from avar._kernels.allan.pyramid import largest_magnitude
+from avar._kernels.allan.haar import largest_magnitude
 from avar._kernels.dd import EPS
 from avar._kernels.runtime.tasks import run_tasks
 

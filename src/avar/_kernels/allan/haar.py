@@ -76,22 +76,29 @@ def _dd_diff(ah, al, bh, bl):
     return s + (e + (al - bl))
 
 
-#: Bits of a float64's magnitude; a magnitude's bits at or above INFINITY_BITS are inf or NaN.
+#: Bits of a float64's magnitude; a magnitude's bits at or above :data:`INFINITY_BITS` are inf or NaN.
 MAGNITUDE_MASK = np.int64(0x7FFFFFFFFFFFFFFF)
 INFINITY_BITS = np.int64(0x7FF0000000000000)
 
 
 @njit(cache=True)
-def _magnitude(x):
-    """Largest ``|x|`` of float64 values, NaN if one is not finite: the maximum of the
-    magnitudes' bit patterns (ordered as the magnitudes; integer maxima vectorize)."""
-    bits = x.view(np.int64)
+def largest_magnitude(values):
+    """Largest ``|v|`` of float64 ``values`` (0 if none), inf if one is not finite: the maximum
+    of the magnitudes' bit patterns, which are ordered as the magnitudes (integer maxima vectorize)."""
+    bits = values.view(np.int64)
     top = np.int64(0)
     for i in range(bits.shape[0]):
         top = max(top, bits[i] & MAGNITUDE_MASK)
     if top >= INFINITY_BITS:
-        return np.nan
+        return np.inf
     return np.array([top]).view(np.float64)[0]
+
+
+@njit(cache=True)
+def _magnitude(x):
+    """Largest ``|x|`` of float64 values, NaN if one is not finite (a finite maximum is never inf)."""
+    top = largest_magnitude(x)
+    return np.nan if top == np.inf else top
 
 
 def _scaled_magnitude(x, sc):  # pragma: no cover - replaced by the overload in compiled code

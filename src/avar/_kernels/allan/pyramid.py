@@ -36,6 +36,7 @@ import numpy as np
 from numba import njit
 
 from avar._kernels.allan.blocks import CERTIFY_TOL, certified
+from avar._kernels.allan.haar import largest_magnitude
 from avar._kernels.allan.sweep import sweep_task
 from avar._kernels.dd import EPS
 from avar._kernels.runtime.tasks import run_tasks
@@ -50,24 +51,6 @@ PYRAMID_NEAR = 1 << 13
 
 #: Blocks per parallel task (fixes the summation order).
 PYRAMID_CHUNK = 8
-
-
-#: Bits of a float64's magnitude; a magnitude's bits at or above :data:`INFINITY_BITS` are inf or NaN.
-MAGNITUDE_MASK = np.int64(0x7FFFFFFFFFFFFFFF)
-INFINITY_BITS = np.int64(0x7FF0000000000000)
-
-
-@njit(cache=True)
-def largest_magnitude(values):
-    """Largest ``|v|`` of float64 ``values`` (0 if none), inf if one is not finite: the maximum
-    of the magnitudes' bit patterns, which are ordered as the magnitudes (integer maxima vectorize)."""
-    bits = values.view(np.int64)
-    top = np.int64(0)
-    for i in range(bits.shape[0]):
-        top = max(top, bits[i] & MAGNITUDE_MASK)
-    if top >= INFINITY_BITS:
-        return np.inf
-    return np.array([top]).view(np.float64)[0]
 
 
 @njit(cache=True)
