@@ -150,6 +150,7 @@ def test_a_datetime64_seconds_index_with_400_year_steps():
 
 
 # --------------------------------------------------------------------------- magnitudes and bounds
+@pytest.mark.filterwarnings("error::RuntimeWarning")  # an overflow is the function's error, not a stray warning
 @pytest.mark.parametrize("estimator", DEVIATIONS, ids=lambda f: f.__name__)
 def test_deviations_of_data_near_the_float64_limits(estimator):
     base = estimator(X[:512])

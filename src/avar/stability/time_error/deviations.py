@@ -83,12 +83,12 @@ def _estimate(statistic: str, data: Any, rate: Any, data_type: Any, taus: Any, c
         with np.errstate(over="ignore"):  # an overflow is an error below
             variance = deviation**2
     else:
-        if statistic == "pdev":
+        with np.errstate(over="ignore"):  # the twins' squares overflow as the kernels' do: an error below
             sums, n = levels(phase, factors, gaps, extra)
+        if statistic == "pdev":
             m = factors.astype(np.float64)
             scale = np.where(factors == 1, 2.0, m**4 / 72.0)
         else:
-            sums, n = levels(phase, factors, gaps, extra)
             m, scale = factors.astype(np.float64), 1.0
             if data_type == "freq":  # m = N: the one term spans the mean-removed data, zero by construction
                 sums = np.where((factors == n_phase - 1) & (n > 0), 0.0, sums)
