@@ -41,6 +41,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from avar._kernels.classic.sums import CUMSUM_BLOCK
+
 #: Unit roundoff of float64.
 EPS = 2.0**-53
 #: Running sums of the high parts stay within 2**HIGH_BITS grid units: differences up to the
@@ -285,3 +287,66 @@ def level_sums(data: np.ndarray, kind: int, centre: float, slope: float, scale: 
         if not certified(sums[i], term_error(code, m, phase.step, source.step), count):
             return None
     return Levels(sums, np.asarray(counts, dtype=np.int64), phase.hi + phase.lo, exact.centre, exact.slope)
+
+
+class TwinPhase(NamedTuple):
+    """The compensated phase ``hi + lo`` (``lo`` float32) of :func:`detrended_phase`."""
+
+    hi: np.ndarray
+    lo: np.ndarray
+
+
+def _block(high: np.ndarray, low: np.ndarray | None, start_hi: float, start_lo: float) -> tuple[np.ndarray, np.ndarray | None]:
+    """The kernel's running ``total`` and ``comp`` over one block from ``start_hi + start_lo``:
+    total_k = fl(total_{k-1} + h_k), comp_k = fl(comp_{k-1} + fl(e_k + l_k)), e_k the TwoSum
+    error of the addition; ``low`` None: ``total`` alone (``comp`` None)."""
+    total = np.cumsum(np.concatenate(([start_hi], high)))
+    if low is None:
+        return total[1:], None
+    error = two_sum(total[:-1], high).low
+    comp = np.cumsum(np.concatenate(([start_lo], error + low)))
+    return total[1:], comp[1:]
+
+
+def detrended_phase(data: np.ndarray, data_lo: np.ndarray | None, kind: int, centre: float, slope: float,
+                    scale: float, block: int = CUMSUM_BLOCK, low: bool = True) -> TwinPhase:
+    """:func:`avar._kernels.classic.phase.detrended_phase` in NumPy, bit for bit: ``hi``, ``lo``
+    (M + 1 values, 0 first) of the compensated running sum of the increments less ``centre +
+    slope i``, times ``scale``, by blocks of ``block`` increments (each block's own sum from 0,
+    the blocks' offsets in double-double, then each block from its offset). ``kind`` 0:
+    ``data`` is the frequency, 1: the phase, 2: the increments are ``data + data_lo`` (the
+    running sum of a phase; ``slope`` 0), written as renormalized pairs. ``low`` False (kinds 0
+    and 1): ``hi`` alone, ``lo`` left 0 (the kernel's ``hi`` never reads its compensation).
+
+    >>> detrended_phase(np.array([1.0, 3.0, 2.0]), None, 0, 2.0, 0.0, 1.0).hi.tolist()
+    [0.0, -1.0, 0.0, 0.0]
+    """
+    if kind == 2:
+        high, error = two_sum(data, -centre)
+        pairs = (high * scale, (data_lo.astype(np.float64) + error) * scale)
+    else:
+        pairs = increments(data, kind, centre, slope, scale)
+    high, low_parts = pairs[0], (pairs[1] if low else None)
+    n = high.shape[0]
+    hi = np.zeros(n + 1)
+    lo = np.zeros(n + 1, dtype=np.float32)
+    starts = range(0, n, block)
+
+    def part(b: int) -> np.ndarray | None:
+        return None if low_parts is None else low_parts[b : b + block]
+
+    own = [_block(high[b : b + block], part(b), 0.0, 0.0) for b in starts]  # each block's own sum from 0
+    sums = [(float(t[-1]), 0.0 if c is None else float(c[-1])) for t, c in own]
+    total, comp = 0.0, 0.0
+    for b, (block_hi, block_lo) in zip(starts, sums):  # each block from the earlier blocks' sum (double-double)
+        run_hi, run_lo = _block(high[b : b + block], part(b), total, comp)
+        if kind == 2:
+            run_hi, run_lo = two_sum(run_hi, run_lo)
+        hi[b + 1 : b + 1 + run_hi.shape[0]] = run_hi
+        if run_lo is not None:
+            lo[b + 1 : b + 1 + run_hi.shape[0]] = run_lo
+        s = total + block_hi
+        bv = s - total
+        comp += ((total - (s - bv)) + (block_hi - bv)) + block_lo
+        total = s
+    return TwinPhase(hi, lo)

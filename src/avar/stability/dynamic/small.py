@@ -16,8 +16,9 @@ is cold and the work is small (:func:`avar._kernels.runtime.paths.numpy_path`, c
 The phase the windows read (``hi`` and its float32 compensation ``lo``, as
 :func:`avar.stability.classic.core.phase_parts` builds it with
 :func:`avar._kernels.classic.phase.detrended_phase`) comes, while that kernel is cold too, from
-:func:`twin_phase_parts`: the kernel's blocks, running sums and TwoSum compensations replayed
-with :func:`numpy.cumsum` (sequential, as the kernel's loop), bit for bit.
+:func:`twin_phase_parts` (:func:`avar.stability.classic.small.detrended_phase`): the kernel's
+blocks, running sums and TwoSum compensations replayed with :func:`numpy.cumsum` (sequential, as
+the kernel's loop), bit for bit.
 
 The two paths differ in the last bits of the window sums only (the tests force each path and
 compare them at 1e-12).
@@ -33,9 +34,8 @@ from typing import NamedTuple
 import numpy as np
 from numpy.lib.stride_tricks import as_strided
 
-from avar._kernels.classic.sums import CUMSUM_BLOCK
 from avar.stability.classic.core import MODIFIED, phase_line
-from avar.stability.classic.small import increments, two_sum
+from avar.stability.classic.small import detrended_phase
 
 #: How far past its first point each code's term reaches, in units of m (as the kernel's ``REACH``).
 REACH = {0: 2, 1: 3, 2: 3, 4: 4}
@@ -53,13 +53,6 @@ TWIN_LIMIT = 1 << 25
 PHASE_LIMIT = 1 << 21
 
 
-class TwinPhase(NamedTuple):
-    """The compensated phase ``hi + lo`` (``lo`` float32) of :func:`detrended_phase`."""
-
-    hi: np.ndarray
-    lo: np.ndarray
-
-
 class TwinPhaseParts(NamedTuple):
     """What :func:`avar.stability.classic.core.phase_parts` gives the window kernel: the phase
     (or its running sum) ``hi + lo``, its ``scale`` (a power of two), the gap ``mode`` and
@@ -70,53 +63,6 @@ class TwinPhaseParts(NamedTuple):
     scale: float
     mode: int
     bad: np.ndarray | None
-
-
-def _block(high: np.ndarray, low: np.ndarray, start_hi: float, start_lo: float) -> tuple[np.ndarray, np.ndarray]:
-    """The kernel's running ``total`` and ``comp`` over one block from ``start_hi + start_lo``:
-    total_k = fl(total_{k-1} + h_k), comp_k = fl(comp_{k-1} + fl(e_k + l_k)), e_k the TwoSum
-    error of the addition."""
-    total = np.cumsum(np.concatenate(([start_hi], high)))
-    error = two_sum(total[:-1], high).low
-    comp = np.cumsum(np.concatenate(([start_lo], error + low)))
-    return total[1:], comp[1:]
-
-
-def detrended_phase(data: np.ndarray, data_lo: np.ndarray | None, kind: int, centre: float, slope: float,
-                    scale: float, block: int = CUMSUM_BLOCK) -> TwinPhase:
-    """:func:`avar._kernels.classic.phase.detrended_phase` in NumPy, bit for bit: ``hi``, ``lo``
-    (M + 1 values, 0 first) of the compensated running sum of the increments less ``centre +
-    slope i``, times ``scale``, by blocks of ``block`` increments (each block's own sum from 0,
-    the blocks' offsets in double-double, then each block from its offset). ``kind`` 0:
-    ``data`` is the frequency, 1: the phase, 2: the increments are ``data + data_lo`` (the
-    running sum of a phase; ``slope`` 0), written as renormalized pairs.
-
-    >>> detrended_phase(np.array([1.0, 3.0, 2.0]), None, 0, 2.0, 0.0, 1.0).hi.tolist()
-    [0.0, -1.0, 0.0, 0.0]
-    """
-    if kind == 2:
-        high, error = two_sum(data, -centre)
-        pairs = (high * scale, (data_lo.astype(np.float64) + error) * scale)
-    else:
-        pairs = increments(data, kind, centre, slope, scale)
-    high, low = pairs
-    n = high.shape[0]
-    hi = np.zeros(n + 1)
-    lo = np.zeros(n + 1, dtype=np.float32)
-    starts = range(0, n, block)
-    sums = [tuple(float(v[-1]) for v in _block(high[b : b + block], low[b : b + block], 0.0, 0.0)) for b in starts]
-    total, comp = 0.0, 0.0
-    for b, (block_hi, block_lo) in zip(starts, sums):  # each block from the earlier blocks' sum (double-double)
-        run_hi, run_lo = _block(high[b : b + block], low[b : b + block], total, comp)
-        if kind == 2:
-            run_hi, run_lo = two_sum(run_hi, run_lo)
-        hi[b + 1 : b + 1 + run_hi.shape[0]] = run_hi
-        lo[b + 1 : b + 1 + run_hi.shape[0]] = run_lo
-        s = total + block_hi
-        bv = s - total
-        comp += ((total - (s - bv)) + (block_hi - bv)) + block_lo
-        total = s
-    return TwinPhase(hi, lo)
 
 
 def twin_phase_parts(values: np.ndarray, data_type: str, statistic: str, scanned: tuple) -> TwinPhaseParts:

@@ -11,7 +11,7 @@ are cold and the record is short (:func:`avar._kernels.runtime.paths.numpy_path`
   each block of :data:`avar._kernels.classic.sums.CUMSUM_BLOCK` increments the kernel's ``hi``
   is the plain sequential float64 sum of the increments' high parts, started from the
   sequential sum of the earlier blocks' totals, which :func:`numpy.cumsum` reproduces bit for
-  bit from the same exact pairs (:func:`avar.stability.classic.small.increments`).
+  bit from the same exact pairs (:func:`avar.stability.classic.small.detrended_phase`).
 * :func:`level_sums`: MTOTDEV's and HTOTDEV's levels by the blocked expansion, the same blocks,
   tables and local detrending as the kernel (see :mod:`avar._kernels.total.blocks` for the
   formulas), vectorized over the blocks of one window count. Only the sliding moments are
@@ -43,7 +43,7 @@ from avar._kernels.classic.sums import CUMSUM_BLOCK
 from avar._kernels.runtime.paths import numpy_path
 from avar._kernels.total.blocks import BLOCK_KERNELS, block_size, blocks, level_tables
 from avar._kernels.total.windows import DIRECT_KERNELS, FAST_WORK, THEO1_DIRECT_KERNELS, theo1_sum
-from avar.stability.classic.small import increments
+from avar.stability.classic.small import detrended_phase
 
 #: Unit roundoff of float64.
 EPS = 2.0**-53
@@ -81,22 +81,13 @@ def twin_phase(data: np.ndarray, kind: int, centre: float, slope: float, scale: 
     ``scale``. ``kind`` 0: ``data`` is the frequency, 1: the phase. The kernel sums ``block``
     increments at a time: block b's ``hi`` is the sequential float64 sum of its high parts
     started from the sequential sum of the earlier blocks' totals (each block's own sum from 0),
-    which :func:`numpy.cumsum` reproduces (its ``lo``, which the total family does not read, is
-    not formed).
+    which :func:`numpy.cumsum` reproduces: :func:`avar.stability.classic.small.detrended_phase`
+    without its ``lo``, which the total family does not read.
 
     >>> twin_phase(np.array([1.0, 3.0, 2.0]), 0, 2.0, 0.0, 1.0).tolist()
     [0.0, -1.0, 0.0, 0.0]
     """
-    high = increments(data, kind, centre, slope, scale).high
-    phase = np.zeros(high.shape[0] + 1)
-    offset = 0.0
-    for start in range(0, high.shape[0], block):
-        part = high[start : start + block]
-        own = np.cumsum(part)  # the block's own sum from 0 (the kernel's first pass)
-        # the second pass: the block from the earlier blocks' total, cumsum of (offset, part)
-        phase[start + 1 : start + 1 + part.shape[0]] = np.cumsum(np.concatenate(([offset], part)))[1:] if start else own
-        offset += float(own[-1])
-    return phase
+    return detrended_phase(data, None, kind, centre, slope, scale, block, low=False).hi
 
 
 def _trapezoids(same: np.ndarray, m: int, count: int, nx: int) -> np.ndarray:
