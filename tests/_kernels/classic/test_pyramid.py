@@ -10,7 +10,8 @@ import pytest
 from avar._kernels.classic.levels import level_sums
 from avar._kernels.classic.phase import scan
 from avar._kernels.classic.pyramid import BLOCK_EXP, MOMENTS, SPLIT_BLOCKS, TAIL, octave_moments
-from avar._kernels.uncertainty.noise_id import ILL_CONDITIONED, lag1_alpha_decimated, lag1_alpha_from_moments
+from avar._kernels.uncertainty.lag1 import lag1_alpha_decimated
+from avar._kernels.uncertainty.noise_id import ILL_CONDITIONED, lag1_alpha_from_moments
 from avar.stability.classic.core import OctaveMoments, deviation_levels, octave_sums, phase_parts
 from avar.stability.shared.grids import deviation_factors
 from avar.stability.shared.registry import KERNEL_CODES

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avar._kernels.uncertainty.noise_id import lag1_alpha_decimated, moments_with_drift
+from avar._kernels.uncertainty.lag1 import lag1_alpha_decimated
+from avar._kernels.uncertainty.noise_id import moments_with_drift
 from avar.stability.uncertainty.noise_id import lag1_alpha
 
 
@@ -68,7 +69,7 @@ def test_constant_series_gives_nan():
 
 @pytest.mark.parametrize("factors", [[1, 2, 4, 8, 16, 32, 64, 128], [1, 3, 6, 7, 14, 100, 200], [5], [2, 4]])
 def test_levels_serial_split_and_single_agree(factors):
-    from avar._kernels.uncertainty.noise_id import lag1_levels, lag1_levels_split
+    from avar._kernels.uncertainty.lag1 import lag1_levels, lag1_levels_split
 
     x = series("white fm", 20_000, 1)
     m = np.array(factors, dtype=np.int64)
@@ -168,3 +169,31 @@ def test_a_dominant_drift_in_frequency_data_is_identified_as_exactly(estimator):
     levels = list(result.averaging_factors)
     for m in (128, 256, 512):
         assert found["compiled"][levels.index(m)] == exact_alpha(x, m, 3 if "h" in estimator else 2), m
+
+
+@pytest.mark.parametrize("kind", ["white pm", "white fm", "rw fm"])
+@pytest.mark.parametrize("k", [3, 4, 1025, 1026, 5000])
+def test_contiguous_passes_equal_the_sums_they_stand_for(kind, k):
+    """The vectorized passes of a contiguous series (m = 1) against math.fsum of the same values:
+    the line's projections, then per order (0: r_i - r_0, 1: (r_i - r_{i-1}) - (r_1 - r_0)) the
+    sum, the sum of squares, the lag-1 sum of products, the first and the last value."""
+    import math
+
+    from avar._kernels.uncertainty.lag1 import order_pass_contiguous, projections_contiguous
+
+    x = series(kind, k, 7)
+    half, c2 = (k - 1) / 2.0, (k * k - 1.0) / 12.0
+    t = np.arange(k) - half
+    s0, s1, s2 = projections_contiguous(x, k, half, c2)
+    for got, terms in ((s0, x), (s1, t * x), (s2, (t * t - c2) * x)):
+        assert abs(got - math.fsum(terms)) <= 1e-13 * math.fsum(np.abs(terms))
+    a0, a1 = s0 / k, s1 / (k * (k * k - 1.0) / 12.0)
+    stats = np.zeros((2, 5))
+    order_pass_contiguous(x, k, half, c2, a0, a1, 0.0, stats)
+    r = x - (a0 + a1 * t)
+    a = r - r[0]
+    b = np.diff(r) - (r[1] - r[0])
+    for row, v in ((stats[0], a), (stats[1], b)):
+        for got, terms in ((row[0], v), (row[1], v * v), (row[2], v[:-1] * v[1:])):
+            assert abs(got - math.fsum(terms)) <= 1e-12 * math.fsum(np.abs(terms)) + 1e-300
+        assert row[3] == 0.0 and abs(row[4] - v[-1]) <= 1e-12 * np.abs(v).max()

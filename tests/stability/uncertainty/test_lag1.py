@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from avar._kernels.runtime.paths import forced
-from avar._kernels.uncertainty.noise_id import lag1_alpha_decimated, running_sum
+from avar._kernels.uncertainty.lag1 import lag1_alpha_decimated
+from avar._kernels.uncertainty.noise_id import running_sum
 from avar.stability.uncertainty.lag1 import decimated_alpha, lag1_alphas, running_sums
 
 

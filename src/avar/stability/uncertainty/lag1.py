@@ -2,7 +2,7 @@
 
 :func:`lag1_alphas` and :func:`running_sums` are what :mod:`avar.stability.uncertainty.noise_id`
 calls: up to :data:`NUMPY_POINTS` phase points while the kernels of
-:mod:`avar._kernels.uncertainty.noise_id` are not compiled yet (or when
+:mod:`avar._kernels.uncertainty.lag1` are not compiled yet (or when
 :mod:`avar._kernels.runtime.paths` forces it) they take the NumPy twins here, with nothing to
 compile; otherwise the kernels (2 to 8 times faster warm). Both follow Riley and
 Greenhall's rule as Stable32 applies it (see :func:`decimated_alpha`); they differ only in
@@ -20,7 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 from avar._kernels.runtime.paths import numpy_path
-from avar._kernels.uncertainty.noise_id import lag1_kernels, lag1_levels, lag1_levels_split, running_sum
+from avar._kernels.uncertainty.lag1 import lag1_kernels, lag1_levels, lag1_levels_split
+from avar._kernels.uncertainty.noise_id import running_sum
 
 #: Phase records of at most this many points take the NumPy twins while the kernels are not
 #: compiled yet (:func:`avar._kernels.runtime.paths.numpy_path`; warm, the kernels are faster).
@@ -40,7 +41,7 @@ def _rho(w: np.ndarray) -> float:
 
 def decimated_alpha(x: np.ndarray, m: int, dmax: int, line: float) -> float:
     """alpha of x[0], x[m], x[2m], ... by the lag-1 autocorrelation: the NumPy twin of
-    :func:`avar._kernels.uncertainty.noise_id.lag1_alpha_decimated`.
+    :func:`avar._kernels.uncertainty.lag1.lag1_alpha_decimated`.
 
     With z the K = (N - 1) // m + 1 decimated points and t = i - (K - 1) / 2: ``line`` NaN
     (phase integrated from frequency data) removes z's least-squares line (the mean

@@ -90,7 +90,7 @@ def identify_noise(phase: Any, factors: Any, estimator: str, *, from_frequency: 
        continuous limit its twice-differenced block means have rho = -0.04
        (Greenhall's s_z with F = 1), read as random-walk FM.
     2. If at least K = floor((N - 1) / m) = 30 frequency averages remain (compiled:
-       :func:`avar._kernels.uncertainty.noise_id.lag1_alpha_decimated`): remove the
+       :func:`avar._kernels.uncertainty.lag1.lag1_alpha_decimated`): remove the
        mean of the decimated phase (phase data, as they are) or its line
        (``from_frequency``: the mean frequency); not a drift, as Stable32.
        Stable32's tables of a 556,990-point caesium phase record show the
