@@ -16,11 +16,11 @@ from avar._kernels.allan.blocks import (
     read_only,
     table_task,
 )
-from avar._kernels.allan.far import FAR_SPAN, SWEEP_FINE, far_sums
+from avar._kernels.allan.far import FAR_SPAN, SWEEP_FINE, far_sums, far_task
 from avar._kernels.allan.haar import CHUNK_BLOCKS as HAAR_CHUNK
 from avar._kernels.allan.haar import HAAR_KERNEL, PYRAMID_EXP, haar_sums
 from avar._kernels.allan.levels import level_sums, to_task
-from avar._kernels.allan.pyramid import PYRAMID_BLOCK, PYRAMID_CHUNK, PYRAMID_NEAR, pyramid_sums
+from avar._kernels.allan.pyramid import PYRAMID_BLOCK, PYRAMID_CHUNK, PYRAMID_NEAR, pyramid_sums, pyramid_task
 from avar._kernels.allan.small import PARALLEL_KERNEL, small_allan_variance, small_allan_variance_parallel
 from avar._kernels.allan.sweep import SWEEP_BLOCK, SWEEP_CHUNK, SWEEP_NEAR, sweep_sums
 
@@ -188,6 +188,14 @@ def column_kernels(data, factors, type: str) -> list[KernelCall]:
     if f.size and np.all((f & (f - 1)) == 0):
         return [KernelCall(HAAR_KERNEL, x.T)]
     return [KernelCall(table_task, x), KernelCall(to_task, x)]
+
+
+def sweep_kernels(data) -> list[KernelCall]:
+    """The compiled loops :func:`run_sweep` runs on ``data`` (N, C), as :class:`KernelCall`
+    entries of :func:`avar._kernels.runtime.paths.compiled` (the far levels' exact redo,
+    compiled only when a piece needs it, aside)."""
+    x = _as_kernel_input(data)
+    return [KernelCall(table_task, x), KernelCall(pyramid_task, x.T), KernelCall(far_task, x.T)]
 
 
 def allan_variance_columns(data, factors, type: str) -> np.ndarray:

@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from avar._kernels.allan.columns import run_sweep, sweep_kernels
 from avar._kernels.classic.levels import detrended_phase, level_kernels, level_sums, scan
 from avar._kernels.classic.phase import PHASE_KERNELS, centred_moment
 from avar._kernels.classic.pyramid import MOMENTS, SUM_COLUMN, TAIL, octave_moments
@@ -45,6 +46,9 @@ _NO_LO = np.zeros(1, dtype=np.float32)
 #: of 2**18 points, 0.6 s for TOTDEV's 1e4 levels of 1e4 points); longer records compile, as before.
 NUMPY_SAMPLES = 1 << 18
 NUMPY_TERMS = 1 << 27
+#: Gap-free frequency data of at least this many values at the octave factors: OADEV's levels by
+#: the "mo" Allan variance's sweep (:func:`oadev_by_sweep`), which never builds the phase.
+SWEEP_SAMPLES = 1 << 16
 
 
 def _filled(data: np.ndarray, is_phase: bool, n_missing: int) -> tuple[np.ndarray, np.ndarray | None]:
@@ -304,12 +308,34 @@ def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.nda
     elif estimator in ("adev", "hdev") and data_type == "freq" and scanned[0] == 0 and _is_octave(factors):
         sums, counts, scale, phase, drift = octave_sums(estimator, data, factors, scanned)
         line = None
+    elif _sweeps(estimator, data, factors, data_type, scanned):
+        return oadev_by_sweep(data, factors, scanned)
     else:
         hi, lo, scale, mode, bad, phase, drift, line = phase_parts(data, data_type, estimator, scanned, True)
         strides, first, last = term_ranges(estimator, n_phase, factors)
         sums, counts = level_sums(hi, lo, KERNEL_CODES[estimator], factors, strides, first, last, mode, bad)
     variance = variance_of_sums(estimator, sums, counts, factors, scale, data_type, rate)
     return LevelsAndPhase(variance, counts, phase, drift, line)
+
+
+def _sweeps(estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str, scanned: tuple) -> bool:
+    """Whether OADEV takes :func:`oadev_by_sweep`: gap-free frequency data of at least
+    :data:`SWEEP_SAMPLES` values at the octave factors."""
+    return (estimator == "oadev" and data_type == "freq" and scanned[0] == 0 and data.shape[0] >= SWEEP_SAMPLES
+            and _is_octave(factors))
+
+
+def oadev_by_sweep(data: np.ndarray, factors: np.ndarray, scanned: tuple) -> LevelsAndPhase:
+    """OADEV of gap-free frequency data at the octave factors without its phase: the variances are
+    the "mo" Allan variance of the data (the same sums of squared differences of m-point sums,
+    N + 1 - 2m of them), by its sweep of moving sums by pairs (:func:`avar._kernels.allan.columns.run_sweep`,
+    certified, compensated where a level needs it; about half the work of the phase and its
+    levels), and the noise identification reads the moments of ADEV's Haar pyramid (the same
+    decimated phase x_0, x_m, x_2m, ...), as ADEV's does."""
+    counts = term_counts("oadev", data.shape[0] + 1, factors)
+    variance = run_sweep(data[:, None], factors, counts)[0]
+    _, _, _, moments, _ = octave_sums("adev", data, factors, scanned)
+    return LevelsAndPhase(np.where(counts == 0, np.nan, variance), counts, moments, 0.0, None)
 
 
 class NumpyLevels(NamedTuple):
@@ -339,6 +365,8 @@ def numpy_levels(estimator: str, data: np.ndarray, factors: np.ndarray, data_typ
     def kernels() -> tuple:  # the compiled route this call would take
         if estimator in ("adev", "hdev") and data_type == "freq" and _is_octave(factors):
             return (lag1_alpha_from_moments,)  # the pyramid's (its noise identification, compiled with it)
+        if _sweeps(estimator, data, factors, data_type, scanned):  # and ADEV's pyramid
+            return (*sweep_kernels(data[:, None]), lag1_alpha_from_moments)
         return PHASE_KERNELS + level_kernels(KERNEL_CODES[estimator], strides)
 
     if scanned[0] != 0 or not numpy_path(lambda: int(np.maximum(counts, 0).sum()) + n_phase, NUMPY_TERMS, kernels,
