@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import avar
+from avar._kernels.runtime.paths import forced
 from avar.stability.classic import core
 
 N = core.SWEEP_SAMPLES + 5
@@ -25,15 +26,30 @@ def test_the_sweep_equals_the_phase_path(kind, monkeypatch):
     calls = []
     sweep = core.oadev_by_sweep
     monkeypatch.setattr(core, "oadev_by_sweep", lambda *a: calls.append(1) or sweep(*a))
-    fast = avar.oadev(y)
-    assert calls, "the record did not take the sweep"
-    monkeypatch.setattr(core, "SWEEP_SAMPLES", 1 << 40)
-    plain = avar.oadev(y)
+    with forced("compiled"):  # the sweep's kernels, compiled or not
+        fast = avar.oadev(y)
+        assert calls, "the record did not take the sweep"
+        monkeypatch.setattr(core, "SWEEP_SAMPLES", 1 << 40)
+        plain = avar.oadev(y)
     assert len(calls) == 1
     np.testing.assert_array_equal(fast.n, plain.n)
     np.testing.assert_allclose(fast.variance, plain.variance, rtol=1e-12, atol=0)
     np.testing.assert_array_equal(fast.alpha, plain.alpha)
     np.testing.assert_allclose(fast.edf, plain.edf, rtol=1e-12)
+
+
+def test_cold_sweep_kernels_leave_the_phase_path(monkeypatch):
+    """While the sweep's kernels are not compiled (auto mode), a long record takes the phase path,
+    whose kernels compile in about half the time; forced, the sweep."""
+    y = _record("white fm")
+    calls = []
+    monkeypatch.setattr(core, "oadev_by_sweep", lambda *a: calls.append(1))
+    monkeypatch.setattr(core, "compiled", lambda kernels: False)
+    with forced("auto"):
+        assert core._sweeps("oadev", y, np.array([1, 2, 4]), "freq", core.scan(y)) is False
+    with forced("compiled"):
+        assert core._sweeps("oadev", y, np.array([1, 2, 4]), "freq", core.scan(y)) is True
+    assert not calls
 
 
 def test_the_sweep_equals_a_plain_loop():
@@ -42,7 +58,8 @@ def test_the_sweep_equals_a_plain_loop():
     from fractions import Fraction
 
     y = np.random.default_rng(3).integers(-50, 50, N).astype(np.float64)
-    res = avar.oadev(y)
+    with forced("compiled"):
+        res = avar.oadev(y)
     x = [Fraction(0)]
     for v in y.tolist():
         x.append(x[-1] + Fraction(int(v)))

@@ -420,3 +420,7 @@ def octave_moments(y, centre, slope, scale, order, n_levels, stats, tails):
 
     run_tasks(sides, stretch)
     _finish_moments(n, low, n_levels, sides, order, full, states, top_hi, top_lo, stats, tails)
+
+
+#: The compiled loops of :func:`octave_moments` (whether they are compiled yet: :func:`avar._kernels.runtime.paths.compiled`).
+OCTAVE_KERNELS = (_stretch, _finish_moments)

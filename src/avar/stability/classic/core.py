@@ -21,8 +21,8 @@ import numpy as np
 from avar._kernels.allan.columns import run_sweep, sweep_kernels
 from avar._kernels.classic.levels import detrended_phase, level_kernels, level_sums, scan
 from avar._kernels.classic.phase import PHASE_KERNELS, centred_moment
-from avar._kernels.classic.pyramid import MOMENTS, SUM_COLUMN, TAIL, octave_moments
-from avar._kernels.runtime.paths import numpy_path
+from avar._kernels.classic.pyramid import MOMENTS, OCTAVE_KERNELS, SUM_COLUMN, TAIL, octave_moments
+from avar._kernels.runtime.paths import compiled, numpy_path, path_mode
 from avar._kernels.uncertainty.noise_id import lag1_alpha_from_moments, rn_clusters
 from avar.stability.classic.small import level_sums as small_level_sums
 from avar.stability.shared.registry import KERNEL_CODES
@@ -47,7 +47,8 @@ _NO_LO = np.zeros(1, dtype=np.float32)
 NUMPY_SAMPLES = 1 << 18
 NUMPY_TERMS = 1 << 27
 #: Gap-free frequency data of at least this many values at the octave factors: OADEV's levels by
-#: the "mo" Allan variance's sweep (:func:`oadev_by_sweep`), which never builds the phase.
+#: the "mo" Allan variance's sweep (:func:`oadev_by_sweep`), which never builds the phase, once its
+#: kernels are compiled (see :func:`_sweeps`).
 SWEEP_SAMPLES = 1 << 16
 
 
@@ -320,9 +321,14 @@ def deviation_levels_and_phase(estimator: str, data: np.ndarray, factors: np.nda
 
 def _sweeps(estimator: str, data: np.ndarray, factors: np.ndarray, data_type: str, scanned: tuple) -> bool:
     """Whether OADEV takes :func:`oadev_by_sweep`: gap-free frequency data of at least
-    :data:`SWEEP_SAMPLES` values at the octave factors."""
-    return (estimator == "oadev" and data_type == "freq" and scanned[0] == 0 and data.shape[0] >= SWEEP_SAMPLES
-            and _is_octave(factors))
+    :data:`SWEEP_SAMPLES` values at the octave factors, once the sweep's and the pyramid's kernels
+    are compiled (``avar warmup``, a long ``avar()`` call, numba's cache) or the compiled path is
+    forced. Before, the phase path runs: its kernels compile in about half the time (a first
+    call on 2e6 values, empty cache: 8.5-9 s against 13-15 s, loaded machine), the same values."""
+    if not (estimator == "oadev" and data_type == "freq" and scanned[0] == 0 and data.shape[0] >= SWEEP_SAMPLES
+            and _is_octave(factors)):
+        return False
+    return path_mode() == "compiled" or compiled((*sweep_kernels(data[:, None]), *OCTAVE_KERNELS))
 
 
 def oadev_by_sweep(data: np.ndarray, factors: np.ndarray, scanned: tuple) -> LevelsAndPhase:
