@@ -5,16 +5,16 @@ Usage::
     python benchmarks/bench_deviations.py            # N = 1e5, 1e6, 1e7 (totdev up to 1e6)
     python benchmarks/bench_deviations.py --quick    # N = 1e5, 1e6, one repeat
     python benchmarks/bench_deviations.py --acceptance  # N = 1e6 alone, 5 repeats, no catalogue
-    python benchmarks/bench_deviations.py --total    # MTOTDEV, TTOTDEV, HTOTDEV, Theo1, ThêoH
+    python benchmarks/bench_deviations.py --total    # MTOTDEV, TTOTDEV, HTOTDEV, Theo1, ThêoH, MHTOTDEV
     python benchmarks/bench_deviations.py --total --sizes 1000 3000 100000
 
 ``--total``: the total and Theo statistics (white FM, octave taus, no bias
 correction so that both compute the same numbers) against allantools, timed
 once per call (allantools is O(N^2) Python: 10 s for MTOTDEV at N = 3e3) up
-to ``--peer-max`` points, and ours alone beyond (ThêoH has no peer); wall and
-CPU time (the CPU time counts every thread). MTOTDEV, TTOTDEV and HTOTDEV are
-also timed in the same run by the direct O(N m) loop they used before the
-blocked O(N) expansion (:mod:`avar._kernels.total.blocks`), with the largest
+to ``--peer-max`` points, and ours alone beyond (ThêoH and MHTOTDEV have no peer); wall
+and CPU time (the CPU time counts every thread). MTOTDEV, TTOTDEV, HTOTDEV and MHTOTDEV
+are also timed in the same run by the direct O(N m) loop they used before the blocked
+O(N) expansion (:mod:`avar._kernels.total.blocks`, :mod:`avar._kernels.total.mhtot_blocks`), with the largest
 relative difference of the two results; above ``--loop-max`` points the loop is
 not run and its time is extrapolated from the largest N timed by the octave sum
 of (N - 3m + 1) m (marked ``~``).
@@ -56,6 +56,7 @@ import numpy as np
 from timing import median_time  # benchmarks/timing.py
 
 import avar
+from avar._kernels.runtime.paths import forced
 from avar.stability.classic.core import deviation_levels
 from avar.stability.shared.grids import deviation_factors
 from avar.stability.shared.registry import CLASSIC as ESTIMATORS
@@ -107,7 +108,9 @@ def allantools_full(estimator: str, y: np.ndarray, taus: np.ndarray, rate: float
     return devs, bounds
 
 
-TOTAL = ("mtotdev", "ttotdev", "htotdev", "theo1", "theoh")
+TOTAL = ("mtotdev", "ttotdev", "htotdev", "theo1", "theoh", "mhtotdev")
+#: Those without a bias correction to turn off, and without an allantools peer.
+UNPAIRED = ("theoh", "mhtotdev")
 
 
 def once(function) -> float:
@@ -124,20 +127,21 @@ def window_points(n: int) -> float:
 
 
 #: The statistics whose levels cost O(N m) by the direct loop (O(N) by the blocked expansion).
-LOOPS = ("mtotdev", "ttotdev", "htotdev")
+LOOPS = ("mtotdev", "ttotdev", "htotdev", "mhtotdev")
 
 
 @contextlib.contextmanager
 def direct_loop():
-    """MTOTDEV, TTOTDEV and HTOTDEV by the direct O(N m) loop (the path before the expansion)."""
+    """MTOTDEV, TTOTDEV, HTOTDEV and MHTOTDEV by the direct O(N m) loop (the path before the expansion)."""
+    from avar._kernels.total import mhtot
     from avar._kernels.total import windows as total
 
-    saved = total.FAST_WORK
-    total.FAST_WORK = 1 << 62
+    saved = total.FAST_WORK, mhtot.FAST_WORK
+    total.FAST_WORK = mhtot.FAST_WORK = 1 << 62
     try:
         yield
     finally:
-        total.FAST_WORK = saved
+        total.FAST_WORK, mhtot.FAST_WORK = saved
 
 
 def timed(function, y, options) -> tuple[float, float, object]:
@@ -158,13 +162,13 @@ def bench_total(sizes: list[int], peer_max: int, loop_max: int) -> None:
     for n in sizes:
         y = np.random.default_rng(0).standard_normal(n) * 1e-11
         for name in TOTAL:
-            options = {} if name == "theoh" else {"bias_correction": False}
+            options = {} if name in UNPAIRED else {"bias_correction": False}
             function = getattr(avar, name)
             function(y[:1000], **options)  # numba compilation
             ours, cpu, result = timed(function, y, options)
             peer = "-"
             ratio = "-"
-            if allantools is not None and name != "theoh" and n <= peer_max:
+            if allantools is not None and name not in UNPAIRED and n <= peer_max:
                 factors = result.averaging_factors.astype(float)
                 at = getattr(allantools, name)
                 seconds = once(lambda: at(y, rate=1.0, data_type="freq", taus=factors))  # noqa: B023
@@ -211,6 +215,9 @@ def main() -> None:
     public_ratio = {}
     for n in sizes:
         y = np.random.default_rng(0).standard_normal(n) * 1e-11
+        with forced("compiled"):  # every route's kernels compiled first, as `avar warmup` leaves them
+            for estimator in ESTIMATORS:
+                getattr(avar, estimator)(y)
         for estimator in ESTIMATORS:
             if estimator == "totdev" and n > 10**6:
                 continue

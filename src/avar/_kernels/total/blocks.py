@@ -182,7 +182,7 @@ def _trapezoids(same, m, count, weights, stop):
 
 
 @njit(cache=True, nogil=True)
-def _prepare(values, n0, npts, x, parity):
+def prepare_block(values, n0, npts, x, parity):
     """The block's local running sum x (its values less a line; any line would do, this one is
     close to the least-squares line in local time t) and its running sums over each parity,
     parity[t + 2] = x[t] + parity[t]."""
@@ -240,7 +240,7 @@ def _opposite(x, parity, pairs, count, m):
 
 
 @njit(cache=True, nogil=True)
-def _moments(x, stop, m, moments):
+def sliding_moments(x, stop, m, moments):
     """moments[p, n] = sum_{u<m} u^p x[n + u] for n < ``stop``, slid from n to n + 1 by exact
     recurrences (the new term x[n + m] in, the old x[n] out)."""
     f0 = 0.0
@@ -322,8 +322,8 @@ def _blocks(values, m, starts, counts, first, stop, same, opposite, cross, point
         if count != made:
             _trapezoids(same, m, count, weights, nx)
             made = count
-        _prepare(values, starts[b], nx - 1, x, parity)
-        _moments(x, count + 2 * m, m, moments)
+        prepare_block(values, starts[b], nx - 1, x, parity)
+        sliding_moments(x, count + 2 * m, m, moments)
         out[b] = (_same(x, weights, nx, m) + _opposite(x, parity, opposite, count, m)
                   + _windows(x, moments, cross, points, square, count, m)) / scale
 

@@ -4,7 +4,10 @@ No standard defines it (NIST SP 1065 and Stable32 stop at HTOTDEV); SigmaTau.jl 
 the total (reflected-window) form of the modified Hadamard variance, and avar computes SigmaTau.jl's
 definition (its default, half-means detrending), so the two libraries' numbers can be compared.
 Same signature and :class:`~avar.stability.shared.deviation.Deviation` result as the rest of the
-family; the level sums come from :mod:`avar._kernels.total.mhtot`.
+family; the level sums come from :mod:`avar._kernels.total.mhtot` (small levels by the direct
+loop, large ones by the O(N) blocked expansion of :mod:`avar._kernels.total.mhtot_blocks`), or
+while those kernels are not compiled yet, for short records, from their NumPy twin
+(:mod:`avar.stability.total.small_mhtot`, through :func:`avar._kernels.runtime.paths.numpy_path`).
 """
 
 from __future__ import annotations
@@ -13,7 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from avar._kernels.total.mhtot import level_sums, terms_per_window
+from avar._kernels.runtime.paths import numpy_path
+from avar._kernels.total.mhtot import level_kernels, level_sums, terms_per_window
+from avar._kernels.total.windows import LevelSums
 from avar.stability.classic.deviations import noise_exponents
 from avar.stability.shared.deviation import Deviation
 from avar.stability.shared.docstrings import fill_parameters
@@ -21,6 +26,7 @@ from avar.stability.shared.grids import largest_factor, total_factors
 from avar.stability.shared.inputs import DEFAULT_CONFIDENCE
 from avar.stability.shared.noise_types import ALPHA_PARAMETER, check_alpha
 from avar.stability.shared.term_counts import levels_with_terms, term_counts
+from avar.stability.total import small_mhtot
 from avar.stability.total.deviations import prepared_phase
 from avar.stability.uncertainty.chi2 import CATALOGUE_QUANTILES, chi2_bounds
 from avar.stability.uncertainty.edf import estimator_edf
@@ -52,8 +58,10 @@ def mhtotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus
     more (reflected) terms of the same windows, so its EDF is at least that of the plain
     one in the tau range where the extension adds information, and these bounds are
     conservative there. The noise is identified by MHDEV's rules (lag-1 with up to three
-    differences, B1 with its term count). Each level costs O(N m) (the direct loop of
-    :mod:`avar._kernels.total.mhtot`): fine for records up to ~1e5 points at octave taus.
+    differences, B1 with its term count). Each level costs O(N): its windows are summed in
+    blocks, each block's sum expanded into sliding sums of the running sum of the phase
+    (:mod:`avar._kernels.total.mhtot_blocks`; exact up to rounding, ~1e-13 from the direct
+    O(N m) loop, which sums the small levels).
     {parameters}
     References
     ----------
@@ -77,7 +85,7 @@ def mhtotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus
     if factors.size == 0:
         raise ValueError(f"data has too few points for any mhtotdev level (largest factor "
                          f"{largest_factor('mhtotdev', n_phase)})")
-    sums, counts = level_sums(x, factors, bad, shift)
+    sums, counts = _level_sums(x, factors, bad, shift)
     m = factors.astype(np.float64)
     per_window = np.array([terms_per_window(f) for f in factors.tolist()], dtype=np.float64)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
@@ -102,3 +110,19 @@ def mhtotdev(data: Any, rate: float | None = None, data_type: str = "freq", taus
 
 
 fill_parameters(mhtotdev, ALPHA_PARAMETER)
+
+#: The route of :func:`avar._kernels.runtime.paths.numpy_path` for MHTOTDEV's levels.
+_LEVEL_ROUTE = "total.mhtot_levels"
+
+
+def _level_sums(x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int) -> LevelSums:
+    """The level sums and window counts: by the NumPy twin (:mod:`avar.stability.total.small_mhtot`)
+    while the kernels the levels need are cold and the work is small, if it certifies its
+    rounding; else compiled."""
+    kernels = level_kernels(x.shape[0], factors, bool(bad.size))
+    route = (_LEVEL_ROUTE, *(id(kernel) for kernel in kernels))
+    if numpy_path(small_mhtot.TWIN_WORK * x.shape[0] * factors.size, small_mhtot.TWIN_LIMIT, kernels, route=route):
+        twin = small_mhtot.level_sums(x, factors, bad, shift)
+        if twin is not None:
+            return twin
+    return level_sums(x, factors, bad, shift)
