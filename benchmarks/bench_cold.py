@@ -16,8 +16,7 @@ the peer a user compares with. ``--warm`` adds a second column: the same call wi
 cache the cold run filled. The code of this checkout runs (``src`` first on ``PYTHONPATH``).
 
 Goals (issue 39, on a quiet machine): each statistic's cold total under 2.5 s, ``avar
-deviation`` on a 1e4-point file under 3 s. (MHTOTDEV's level sums cost O(N m): at N = 1e5 its
-warm call takes ~35 s of CPU, so its row measures that, not a compilation.)
+deviation`` on a 1e4-point file under 3 s.
 """
 
 from __future__ import annotations

@@ -62,15 +62,25 @@ def test_kf_twin_equals_kernels_and_definition(name):
         assert terms[i] == pytest.approx(avar_i / theo_i, rel=1e-9)
 
 
-def test_ill_conditioned_kf_falls_back_to_the_kernels():
-    """A phase far from zero: the expanded sums cancel, the twin declines and the kernels' kf is used."""
+def test_ill_conditioned_kf_sums_directly_or_falls_back_to_the_kernels(monkeypatch):
+    """A phase far from zero: the expanded sums cancel. The twin sums the levels that need it
+    directly while that is cheap (its terms then match the definition); beyond its budget of
+    direct terms it declines, and the kernels' kf is used."""
     x = np.cumsum(WHITE[:600]) + 1e9
-    assert theobr.twin_terms(x) is None
-    with forced("numpy"):
-        kf_twin = theobr.theobr_factor(x)
+    terms = theobr.twin_terms(x)
+    no_gaps = np.zeros(0, dtype=np.int64)
+    for i in range(terms.size):
+        m_avar, m_theo = 9 + 3 * i, 12 + 4 * i
+        avar_i = oavar_sums(x, np.array([m_avar]))[0] / (2.0 * m_avar**2 * (x.size - 2 * m_avar))
+        theo_i = theo1_sum(x, m_theo, no_gaps, 0).total / (0.75 * (x.size - m_theo) * m_theo**2)
+        assert terms[i] == pytest.approx(avar_i / theo_i, rel=1e-9)
     with forced("compiled"):
         kf_kernel = theobr.theobr_factor(x)
-    assert kf_twin == kf_kernel
+    with forced("numpy"):
+        assert theobr.theobr_factor(x).kf == pytest.approx(kf_kernel.kf, rel=theobr.KF_TOLERANCE)
+        monkeypatch.setattr(small_theobr, "TWIN_DIRECT_TERMS", 0)
+        assert theobr.twin_terms(x) is None
+        assert theobr.theobr_factor(x) == kf_kernel
 
 
 def test_triangle_products_follow_their_definitions():
@@ -82,3 +92,83 @@ def test_triangle_products_follow_their_definitions():
     np.testing.assert_allclose(small_theobr.hankel_lower(y, kappa, count), hankel, rtol=1e-10, atol=1e-11)
     half = [sum(f[a] * g[m - a] for a in range(0, m // 2 + 1) if m - a < 700) for m in range(count)]
     np.testing.assert_allclose(small_theobr.half_convolution(f, g, count), half, rtol=1e-10, atol=1e-11)
+
+
+@pytest.mark.parametrize("t", [1e-7, 0.004, 0.3, 3.0, 41.0])
+def test_decayed_sums_follow_the_recurrence(t):
+    """y[m + 1] = exp(-t) (y[m] + u[m]) by a plain loop, in one block and in many (t n > SPAN)."""
+    u = RNG.standard_normal((2, 3000))
+    loop = np.zeros_like(u)
+    state = np.zeros(2)
+    for m in range(u.shape[1]):
+        loop[:, m] = state
+        state = np.exp(-t) * (state + u[:, m])
+    np.testing.assert_allclose(small_theobr.decayed_sums(u, t), loop, rtol=0, atol=1e-13 * np.abs(loop).max())
+
+
+def test_running_sums_follow_their_definitions():
+    """The five rows of the kernel's running sums, each from its definition by plain loops (N = 61)."""
+    from avar._kernels.total.theobr import exp_sum
+
+    x = RNG.standard_normal(61)
+    reverse = x[::-1].copy()
+    n = x.size
+    count = 41
+    autocorr = np.array([x[: n - k] @ x[k:] for k in range(n)])
+    squares = np.concatenate(([0.0], np.cumsum(x * x)))
+    rest = squares[n - np.arange(count)] - squares[np.arange(count)]
+    lag = [np.array([z[:a] @ z[a : 2 * a] for a in range(count // 2 + 1)]) for z in (x, reverse)]
+    t, w = exp_sum(count - 1)
+    rows = small_theobr.running_sums(x, reverse, autocorr, rest, lag[0], lag[1], count, t, w)
+
+    def half(f, m):  # sum_{a<=m/2} f[m - a] / a
+        return sum(f[m - a] / a for a in range(1, m // 2 + 1))
+
+    expected = np.zeros((5, count))
+    for m in range(count):
+        expected[0, m] = half(autocorr, m)
+        expected[1, m] = half(rest, m)
+        for z in (x, reverse):
+            expected[2, m] += sum(z[q] * half(z, q) for q in range(m))
+            expected[3, m] += sum(z[p] * z[p + l] / (m - l) for l in range((m + 1) // 2, m) for p in range(m - l))
+            if m % 2 == 0:
+                expected[4, m] += sum(2.0 * z[p] * z[q] / (m - q + p) for q in range(m // 2)
+                                      for p in range(q % 2, q + 1, 2))
+    np.testing.assert_allclose(rows, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+
+
+def test_a_cold_first_call_at_1e5_takes_the_twins(monkeypatch):
+    """N = 1e5 while the kernels are cold, as in a fresh process without numba's cache: kf and the
+    displayed Allan levels come from their NumPy twins (nothing compiles), until the twin has spent
+    its budget; the values are the compiled path's."""
+    from avar._kernels.runtime import paths
+    from avar.stability.total import small
+
+    y = np.random.default_rng(39).standard_normal(100_000)
+    with forced("compiled"):
+        kernel = avar.theoh(y)
+    x = _detrended(np.concatenate(([0.0], np.cumsum(y))))
+    with forced("numpy"):
+        kf_twin = theobr.theobr_factor(x)
+    with forced("compiled"):
+        kf_kernel = theobr.theobr_factor(x)
+    assert kf_twin.kf == pytest.approx(kf_kernel.kf, rel=theobr.KF_TOLERANCE)
+    calls = []
+    monkeypatch.setattr(paths, "compiled", lambda *a, **k: False)
+    monkeypatch.setattr(paths, "_WARM_ROUTES", set())
+    monkeypatch.setattr(paths, "_SPENT", {})
+    for name in ("twin_terms", "theobr_terms"):
+        real = getattr(theobr, name)
+        monkeypatch.setattr(theobr, name, lambda *a, real=real, name=name: calls.append(name) or real(*a))
+    real_allan = small.oavar_sums
+    monkeypatch.setattr(small, "oavar_sums", lambda *a: calls.append("allan twin") or real_allan(*a))
+    with forced("auto"):
+        cold = avar.theoh(y)
+        assert sorted(calls) == ["allan twin", "twin_terms"]
+        np.testing.assert_allclose(cold.deviation, kernel.deviation, rtol=1e-9, atol=0)
+        # ski rental: each call charges what the twin loses to the warm kernels; spent, it compiles
+        per_call = y.size * small_theobr.THEOBR_UNITS + paths.CALL_WORK
+        taken = [theobr.twin_path(y.size) for _ in range(4)]
+        left = (paths.HOT_WORK - per_call) // per_call  # the twin calls left after the one above
+        assert taken == [True] * left + [False] * (4 - left)
+        assert not theobr.twin_path(small_theobr.THEOBR_TWIN_LIMIT + 1)

@@ -22,7 +22,8 @@ its noise identification (:mod:`avar.stability.uncertainty.lag1`), the scan of t
 (:func:`avar.stability.allan.columns.numpy_columns`) and the total family's phase, MTOTDEV,
 TTOTDEV and HTOTDEV levels and Theo1 levels (:mod:`avar.stability.total.deviations`, twins
 :mod:`avar.stability.total.small` and :mod:`avar._kernels.total.theo1_numpy`; ThêoH's kf,
-:mod:`avar.stability.total.small_theobr`; MHTOTDEV's levels, :mod:`avar.stability.total.mhtot`,
+:mod:`avar.stability.total.small_theobr`, and its displayed OADEV levels, twin
+:func:`avar.stability.total.small.oavar_sums`; MHTOTDEV's levels, :mod:`avar.stability.total.mhtot`,
 twin :mod:`avar.stability.total.small_mhtot`) and the dynamic deviations' phase and window sums
 (:mod:`avar.stability.dynamic.estimator`, twin :mod:`avar.stability.dynamic.small`), the time-error
 levels of MTIE, TIE rms, PDEV and GCODEV (:mod:`avar.stability.time_error.deviations`, twin

@@ -168,6 +168,8 @@ def half_convolution(f: np.ndarray, g: np.ndarray, count: int) -> np.ndarray:
 
 #: The compiled kernel of the ends' autocorrelations (Theo1's expansion; TheoBR adds :func:`half_convolution`'s).
 HANKEL_KERNELS = (_hankel_leaves,)
+#: The compiled kernel of :func:`half_convolution`'s leaves (no NumPy twin here: TheoBR's has its own).
+HALF_KERNELS = (_half_leaves,)
 
 
 def phi_sums(z: np.ndarray, count: int) -> np.ndarray:

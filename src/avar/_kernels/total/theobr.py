@@ -30,7 +30,7 @@ from numba import njit
 from scipy import fft
 
 from avar._kernels.runtime.tasks import run_concurrently
-from avar._kernels.total.fft import half_convolution, hankel_lower, phi_sums
+from avar._kernels.total.fft import HALF_KERNELS, half_convolution, hankel_lower, phi_sums
 from avar._kernels.total.split import ExpandedSums
 
 #: Step (in log t) of the exponential sum: its relative error is below 5e-16 at 0.25.
@@ -184,6 +184,10 @@ def theo1_every(x: np.ndarray, largest: int, autocorr: np.ndarray, diagonals: La
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(total > 0, np.maximum(square, weight * squares[-1]) / total, np.inf)
     return ExpandedSums(total, ratio)
+
+
+#: The kernels :func:`theo1_every` compiles on a first call (the Hankel leaves have a NumPy twin of their own).
+THEO1_EVERY_KERNELS = (_running_sums, *HALF_KERNELS)
 
 
 @njit(cache=True, nogil=True)

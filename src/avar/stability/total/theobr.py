@@ -12,11 +12,11 @@ from typing import NamedTuple
 import numpy as np
 
 from avar._kernels.runtime.paths import numpy_path
-from avar._kernels.total.fft import HANKEL_KERNELS, autocorrelation
+from avar._kernels.total.fft import autocorrelation
 from avar._kernels.total.theo1 import split_sums
-from avar._kernels.total.theobr import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
+from avar._kernels.total.theobr import THEO1_EVERY_KERNELS, lag_diagonals, oavar_expanded, oavar_sums, theo1_every
 from avar._kernels.total.windows import theo1_sum
-from avar.stability.total import small_theobr
+from avar.stability.total import small, small_theobr
 
 #: Fewest phase points: the average needs n = floor(N / 6) - 3 >= 0 and Allan terms at m = 9 + 3n.
 MIN_THEOBR_POINTS = 19
@@ -49,8 +49,7 @@ def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> TheoBRFa
     ``x``: gap-free phase, N >= 19 points; ``autocorr``: its FFT autocorrelation, if at hand.
     The units cancel in the ratio.
     """
-    if x.shape[0] <= small_theobr.THEOBR_TWIN_LIMIT and numpy_path(x.shape[0], small_theobr.THEOBR_TWIN_LIMIT,
-                                                                   HANKEL_KERNELS, route=_TWIN_ROUTE):
+    if twin_path(x.shape[0]):
         terms = twin_terms(x, autocorr)  # cold kernels: NumPy, unless a sum needs summing again
         if terms is not None:
             return TheoBRFactor(float(np.mean(terms)), theobr_count(x.shape[0]))
@@ -62,9 +61,33 @@ def theobr_factor(x: np.ndarray, autocorr: np.ndarray | None = None) -> TheoBRFa
 _TWIN_ROUTE = "theobr-factor"
 
 
+def twin_path(n_points: int) -> bool:
+    """Whether kf of ``n_points`` phase points goes to its NumPy twin
+    (:func:`avar._kernels.runtime.paths.numpy_path`): while the kernels its compiled path would
+    compile (:data:`avar._kernels.total.theobr.THEO1_EVERY_KERNELS`, ~2 s) are cold, for up to
+    :data:`~avar.stability.total.small_theobr.THEOBR_TWIN_LIMIT` points, each call charged what
+    the twin loses to the warm kernels (:data:`~avar.stability.total.small_theobr.THEOBR_UNITS`
+    per point).
+
+    >>> from avar._kernels.runtime.paths import forced
+    >>> with forced("compiled"):
+    ...     twin_path(100_000)
+    False
+    """
+    limit = small_theobr.THEOBR_TWIN_LIMIT
+    return n_points <= limit and numpy_path(n_points * small_theobr.THEOBR_UNITS, limit * small_theobr.THEOBR_UNITS,
+                                            THEO1_EVERY_KERNELS, route=_TWIN_ROUTE)
+
+
 def twin_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> np.ndarray | None:
-    """:func:`theobr_terms`' terms by the NumPy twin (:mod:`avar.stability.total.small_theobr`), or
-    None where some expanded sum is too ill-conditioned for kf's tolerance (the kernels then sum it again)."""
+    """:func:`theobr_terms`' terms by the NumPy twin (:mod:`avar.stability.total.small_theobr`).
+
+    The sums too ill-conditioned for kf's tolerance (:func:`_levels_to_redo`, each kind half of
+    it, as :func:`theobr_terms`) are summed directly in NumPy (:func:`avar.stability.total.small.oavar_sums`,
+    :func:`~avar.stability.total.small.theo1_level_sums`: the kernels' last resort) while their
+    terms stay within :data:`~avar.stability.total.small_theobr.TWIN_DIRECT_TERMS`; beyond that
+    (random-walk FM of N ~ 1e5: about 70 Theo1 levels up to m ~ 280, 5e8 terms) the result is
+    None and the kernels sum them again, by the split expansion first."""
     n_points = x.shape[0]
     n = theobr_count(n_points)
     i = np.arange(n + 1, dtype=np.int64)
@@ -73,13 +96,24 @@ def twin_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> np.ndarray 
     autocorr = autocorrelation(x) if autocorr is None else autocorr
     diagonals = small_theobr.lag_diagonals(x, int(m_avar[-1]) + 1)
     avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
-    avar = avar_sums / (2.0 * m_avar * m_avar * (n_points - 2 * m_avar))
+    avar_norm = 2.0 * m_avar * m_avar * (n_points - 2 * m_avar)
     every = small_theobr.theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
-    theo = every.sums[m_theo] / (0.75 * (n_points - m_theo) * m_theo * m_theo)
-    terms = avar / theo
-    if _levels_to_redo(terms, avar_ratio, 0.5).size or _levels_to_redo(terms, every.ratios[m_theo], 0.5).size:
+    theo_norm = 0.75 * (n_points - m_theo) * m_theo * m_theo
+    sums = every.sums[m_theo]
+    redo = _levels_to_redo(avar_sums / avar_norm / (sums / theo_norm), avar_ratio, 0.5)
+    work = n_points * redo.size
+    if work > small_theobr.TWIN_DIRECT_TERMS:
         return None
-    return terms
+    if redo.size:
+        avar_sums[redo] = small.oavar_sums(x, m_avar[redo])
+    avar = avar_sums / avar_norm
+    redo = _levels_to_redo(avar / (sums / theo_norm), every.ratios[m_theo], 0.5)
+    work += small.theo1_work(n_points, m_theo[redo])
+    if work > small_theobr.TWIN_DIRECT_TERMS:
+        return None
+    if redo.size:
+        sums[redo] = small.theo1_level_sums(x, m_theo[redo], np.zeros(0, dtype=np.int64), 0).sums
+    return avar / (sums / theo_norm)
 
 
 def theobr_count(n_points: int) -> int:
@@ -154,7 +188,8 @@ def _levels_to_redo(terms: np.ndarray, ratio: np.ndarray, share: float = 1.0) ->
     direct sums than a per-level tolerance would (random-walk FM, N = 1e5: about 50 of 3332
     levels, the smallest m, instead of 1368). A non-finite term or ratio is always redone.
     """
-    error = np.abs(terms) * ERROR_PER_RATIO * ratio
+    with np.errstate(invalid="ignore", over="ignore"):  # 0 x inf (a zero sum's ratio): redone as inf below
+        error = np.abs(terms) * ERROR_PER_RATIO * ratio
     error[~np.isfinite(error)] = np.inf
     order = np.argsort(-error, kind="stable")
     remaining = np.cumsum(error[order][::-1])[::-1]  # error of the levels from this one on

@@ -66,6 +66,21 @@ def _levels(n_phase: int, rate: float, taus: Any, k: float | None) -> tuple[np.n
     return allan, theo
 
 
+#: The route of :func:`avar._kernels.runtime.paths.numpy_path` for the displayed Allan levels alone.
+_ALLAN_ROUTE = "total.theoh.allan"
+#: Largest work (points x levels) whose Allan sums :func:`_allan_sums` leaves to NumPy while the
+#: kernel is cold (one pass per level: ~0.1 s; the kernel compiles in ~0.3 s).
+ALLAN_LIMIT = 1 << 24
+
+
+def _allan_sums(x: np.ndarray, factors: np.ndarray) -> np.ndarray:
+    """The displayed OADEV levels' sums (:func:`avar._kernels.total.theobr.oavar_sums`), by its
+    NumPy twin (:func:`avar.stability.total.small.oavar_sums`, the same terms) while the kernel is cold."""
+    if numpy_path(x.shape[0] * factors.shape[0], ALLAN_LIMIT, (oavar_sums,), route=_ALLAN_ROUTE):
+        return small.oavar_sums(x, factors)
+    return oavar_sums(x, factors)
+
+
 def theoh(data: Any, rate: float | None = None, data_type: str = "freq", taus: Any = "octave",
           confidence: float = DEFAULT_CONFIDENCE, nan_policy: str = "raise", alpha: int | None = None,
           switch: float | None = None) -> Deviation:
@@ -161,7 +176,7 @@ def theoh(data: Any, rate: float | None = None, data_type: str = "freq", taus: A
         (kf, _), sums, allan_sums = run_concurrently(  # kf and the displayed levels at the same time
             lambda: theobr_factor(x, autocorr),
             lambda: theo1_sums(x, theo, small.theo1_direct(no_gaps, 0), autocorr).sums,
-            lambda: oavar_sums(x, allan))
+            lambda: _allan_sums(x, allan))
     counts = n_phase - theo
     with np.errstate(over="ignore"):  # an overflow is an error below
         avar = allan_sums / (2.0 * allan * allan * (n_phase - 2 * allan)) / scale / scale * unit
