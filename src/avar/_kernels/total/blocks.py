@@ -374,17 +374,22 @@ def level_sum(values: np.ndarray, m: int, clean: np.ndarray | None = None) -> fl
     A run of clean windows n = a .. b - 1 is every window of ``values[a : b + 3m - 1]``."""
     m = int(m)
     n_terms = values.shape[0] - 3 * m + 1
-    if n_terms <= 0:
-        return 0.0
+    return run_blocks(values, m, n_terms, clean, _blocks, level_tables(m)) if n_terms > 0 else 0.0
+
+
+def run_blocks(values: np.ndarray, m: int, n_terms: int, clean: np.ndarray | None, kernel, tables: tuple) -> float:
+    """A blocked level sum (this module's and :mod:`avar._kernels.total.mhtot_blocks`'): the
+    ``n_terms`` windows (those where ``clean`` is set) in blocks of at most :func:`block_size`
+    windows, ``kernel(values, m, starts, counts, first, stop, *tables, out)`` over ranges of
+    blocks on the threads, the blocks' sums added in order (the bits do not depend on the threads)."""
     size = block_size(m)
     starts, counts = blocks(n_terms, size, clean)
     n_blocks = starts.size
     out = np.zeros(n_blocks)
-    tables = level_tables(m)
 
     def work(first: int, stop: int) -> None:
         if stop > first:
-            _blocks(values, m, starts, counts, first, stop, *tables, out)
+            kernel(values, m, starts, counts, first, stop, *tables, out)
 
     if size < LARGE_BLOCK:
         run_ranges(n_blocks, work)

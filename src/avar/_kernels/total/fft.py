@@ -75,14 +75,14 @@ class LeafBlocks(NamedTuple):
     length: int
 
 
-def leaf_blocks(count: int) -> LeafBlocks:
-    """The smallest ``length = leaf * 2**k >= count`` over the leaf sizes :data:`LEAVES`.
+def leaf_blocks(count: int, leaves: tuple = LEAVES) -> LeafBlocks:
+    """The smallest ``length = leaf * 2**k >= count`` over the leaf sizes ``leaves`` (:data:`LEAVES`).
 
-    >>> leaf_blocks(1000)
-    LeafBlocks(leaf=125, length=1000)
+    >>> leaf_blocks(1000), leaf_blocks(1000, (8, 9, 10))
+    (LeafBlocks(leaf=125, length=1000), LeafBlocks(leaf=8, length=1024))
     """
     best = None
-    for leaf in LEAVES:
+    for leaf in leaves:
         length = leaf
         while length < count:
             length *= 2

@@ -51,8 +51,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from avar._kernels.runtime.tasks import run_ranges, run_tasks, threads
-from avar._kernels.total.blocks import LARGE_BLOCK, block_size, blocks, prepare_block, sliding_moments
+from avar._kernels.total.blocks import prepare_block, run_blocks, sliding_moments
 
 #: The weights of A_j = sum_q WEIGHTS[q] E(j + q m): minus the fourth difference of E.
 WEIGHTS = (-1, 4, -6, 4, -1)
@@ -378,22 +377,4 @@ def level_sum(x: np.ndarray, m: int, clean: np.ndarray | None = None) -> float:
     """
     m = int(m)
     n_terms = x.shape[0] - 4 * m + 1
-    if n_terms <= 0:
-        return 0.0
-    size = block_size(m)
-    starts, counts = blocks(n_terms, size, clean)
-    n_blocks = starts.size
-    out = np.zeros(n_blocks)
-    tables = level_tables(m)
-
-    def work(first: int, stop: int) -> None:
-        if stop > first:
-            _blocks(x, m, starts, counts, first, stop, *tables, out)
-
-    if size < LARGE_BLOCK:
-        run_ranges(n_blocks, work)
-    else:  # one range per thread: each range allocates and first touches its block's arrays
-        parts = min(n_blocks, threads())
-        bounds = [n_blocks * p // parts for p in range(parts + 1)]
-        run_tasks(parts, lambda p: work(bounds[p], bounds[p + 1]))
-    return float(np.sum(out))
+    return run_blocks(x, m, n_terms, clean, _blocks, level_tables(m)) if n_terms > 0 else 0.0

@@ -185,19 +185,34 @@ def _block_sums(values: np.ndarray, m: int, starts: np.ndarray, count: int, tabl
     return total / scale, SAFETY * EPS * magnitude / scale
 
 
-def level_sum(values: np.ndarray, m: int, clean: np.ndarray | None = None) -> tuple[float, float]:
-    """:func:`avar._kernels.total.blocks.level_sum` in NumPy, and a bound on its rounding error."""
-    n_terms = values.shape[0] - 3 * m + 1
+class TwinLevelSum(NamedTuple):
+    """One level's sum by a twin and a bound on its rounding error (:func:`blocked_level_sum`)."""
+
+    total: float
+    bound: float
+
+
+def blocked_level_sum(values: np.ndarray, m: int, n_terms: int, clean: np.ndarray | None,
+                      block_sums: Callable, tables: object) -> TwinLevelSum:
+    """A blocked expansion's level sum in NumPy (this module's and :mod:`avar.stability.total.small_mhtot`'):
+    the kernels' blocks over the ``n_terms`` windows (those where ``clean`` is set), the blocks of
+    each window count at once by ``block_sums(values, m, starts, count, tables)`` (their sums and
+    rounding bounds), added up."""
     if n_terms <= 0:
-        return 0.0, 0.0
+        return TwinLevelSum(0.0, 0.0)
     starts, counts = blocks(n_terms, block_size(m), clean)
     out = np.zeros(starts.size)
     bound = np.zeros(starts.size)
-    tables = level_tables(m)
     for count in np.unique(counts).tolist():
         which = np.flatnonzero(counts == count)
-        out[which], bound[which] = _block_sums(values, m, starts[which], count, tables)
-    return float(np.sum(out)), float(np.sum(bound))
+        out[which], bound[which] = block_sums(values, m, starts[which], count, tables)
+    return TwinLevelSum(float(np.sum(out)), float(np.sum(bound)))
+
+
+def level_sum(values: np.ndarray, m: int, clean: np.ndarray | None = None) -> TwinLevelSum:
+    """:func:`avar._kernels.total.blocks.level_sum` in NumPy, and a bound on its rounding error."""
+    n_terms = values.shape[0] - 3 * m + 1
+    return blocked_level_sum(values, m, n_terms, clean, _block_sums, level_tables(m) if n_terms > 0 else None)
 
 
 def level_sums(kind: int, x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int) -> TwinLevelSums | None:

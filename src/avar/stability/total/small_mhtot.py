@@ -21,14 +21,12 @@ gaps) and compare them at 1e-12.
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
 
-from avar._kernels.total.blocks import block_size, blocks
 from avar._kernels.total.mhtot import clean_windows
 from avar._kernels.total.mhtot_blocks import MhtotTables, level_tables
 from avar._kernels.total.windows import LevelSums
+from avar.stability.total.small import TwinLevelSum, blocked_level_sum
 
 #: Unit roundoff of float64.
 EPS = 2.0**-53
@@ -184,26 +182,10 @@ def _block_sums(values: np.ndarray, m: int, starts: np.ndarray, count: int,
     return total, SAFETY * EPS * magnitude
 
 
-class TwinLevelSum(NamedTuple):
-    """One level's sum by the twin and a bound on its rounding error (:func:`level_sum`)."""
-
-    total: float
-    bound: float
-
-
 def level_sum(x: np.ndarray, m: int, clean: np.ndarray | None = None) -> TwinLevelSum:
     """:func:`avar._kernels.total.mhtot_blocks.level_sum` in NumPy, and a bound on its rounding error."""
     n_terms = x.shape[0] - 4 * m + 1
-    if n_terms <= 0:
-        return TwinLevelSum(0.0, 0.0)
-    starts, counts = blocks(n_terms, block_size(m), clean)
-    out = np.zeros(starts.size)
-    bound = np.zeros(starts.size)
-    tables = level_tables(m)
-    for count in np.unique(counts).tolist():
-        which = np.flatnonzero(counts == count)
-        out[which], bound[which] = _block_sums(x, m, starts[which], count, tables)
-    return TwinLevelSum(float(np.sum(out)), float(np.sum(bound)))
+    return blocked_level_sum(x, m, n_terms, clean, _block_sums, level_tables(m) if n_terms > 0 else None)
 
 
 def level_sums(x: np.ndarray, factors: np.ndarray, bad: np.ndarray, shift: int) -> LevelSums | None:

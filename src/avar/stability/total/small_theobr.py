@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import fft
 
-from avar._kernels.total.fft import LeafBlocks, padded
+from avar._kernels.total.fft import leaf_blocks, padded
 from avar._kernels.total.split import ExpandedSums
 from avar._kernels.total.theobr import LagDiagonals, exp_sum
 
@@ -47,29 +47,13 @@ TWIN_LEAVES = (8, 9, 10, 12, 15)
 SPAN = 256.0
 
 
-def leaf_blocks(count: int) -> LeafBlocks:
-    """The smallest ``length = leaf * 2**k >= count`` over :data:`TWIN_LEAVES`.
-
-    >>> leaf_blocks(1000)
-    LeafBlocks(leaf=8, length=1024)
-    """
-    best = None
-    for leaf in TWIN_LEAVES:
-        length = leaf
-        while length < count:
-            length *= 2
-        if best is None or length < best.length:
-            best = LeafBlocks(leaf, length)
-    return best
-
-
 def hankel_lower(y: np.ndarray, kappa: np.ndarray, count: int) -> np.ndarray:
     """out[g] = sum_{i<g} y[i] kappa[g + i], g = 0 .. count - 1 (:func:`avar._kernels.total.fft.hankel_lower`).
 
     >>> hankel_lower(np.ones(4), np.arange(8.0), 4).tolist()
     [0.0, 1.0, 5.0, 12.0]
     """
-    leaf, length = leaf_blocks(count)
+    leaf, length = leaf_blocks(count, TWIN_LEAVES)
     yy = padded(y, length)
     kk = padded(kappa, 3 * length)
     out = np.zeros(length)
@@ -97,7 +81,7 @@ def half_convolution(f: np.ndarray, g: np.ndarray, count: int) -> np.ndarray:
     >>> half_convolution(np.ones(3), np.ones(3), 5).tolist()
     [1.0, 1.0, 2.0, 1.0, 1.0]
     """
-    leaf, length = leaf_blocks(count)
+    leaf, length = leaf_blocks(count, TWIN_LEAVES)
     ff = padded(f, length)
     gg = np.zeros(g.shape[:-1] + (length,))
     gg[..., : min(length, g.shape[-1])] = g[..., :length]
