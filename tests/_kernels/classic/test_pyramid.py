@@ -229,3 +229,21 @@ def test_array_chunk_equals_its_plain_twin(order, count):
     sums = [0, 1, 2, 3, 4, 5, 6, 7, 8, 15, 16]  # running moments, last differences
     np.testing.assert_allclose(fast[sums], plain[sums], rtol=1e-12, atol=0)
     assert plain[6] > 0 and plain[7] > 0 and (order == 1 or plain[8] > 0)
+
+
+def test_first_level_pairs_are_phase_increments_bit_for_bit():
+    """Level 1's exact pairs (y - centre) scale, written out branch free when no drift is removed,
+    are phase_increment's, bits and signs of zero included. Their second parts lie below any
+    tolerance a sum could show (a mutant that drops them passes the value tests): bits can fail."""
+    from avar._kernels.classic.phase import phase_increment
+    from avar._kernels.classic.pyramid import _NO_LO, _increments
+
+    rng = np.random.default_rng(4)
+    y = np.concatenate([rng.standard_normal(3000) * 10.0 ** rng.integers(-8, 9, 3000), [0.0, -0.0, 1e-300, 3.0]])
+    centre, scale = float(np.mean(y)), 2.0**-5
+    hh, ll = np.zeros(y.size + 3), np.zeros(y.size + 3)
+    _increments(y, 0, y.size, centre, 0.0, scale, hh, ll)
+    pairs = np.array([tuple(phase_increment(y, _NO_LO, i, 0, centre, 0.0, scale)) for i in range(y.size)])
+    assert np.array_equal(hh[3:], pairs[:, 0]) and np.array_equal(ll[3:], pairs[:, 1])
+    assert np.array_equal(np.signbit(ll[3:]), np.signbit(pairs[:, 1]))
+    assert np.count_nonzero(ll[3:]) > 100  # the second parts are exercised
