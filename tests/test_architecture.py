@@ -156,6 +156,8 @@ TUPLE_RETURNS_ALLOWED = {
     "avar._kernels.dd.two_sum": "the (sum, rounding error) pair of Knuth's error-free TwoSum, unpacked at once in "
                                 "the innermost compensated loops of the allan and classic kernels",
     "avar._kernels.dd.fast_two_sum": "Dekker's FastTwoSum: as two_sum",
+    "avar._kernels.prefetch.prefetch": "a numba intrinsic: numba's protocol has its typing function return "
+                                       "(signature, codegen); its callers call the compiled hint, which returns nothing",
 }
 #: Still to convert by their owners (issue 37); remove each entry with its conversion.
 TUPLE_RETURNS_PENDING: dict[str, str] = {}

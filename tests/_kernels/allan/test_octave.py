@@ -263,15 +263,17 @@ def test_far_levels_exact_with_local_prefixes_exact_steps_or_either(name):
 @pytest.mark.parametrize("name", ["white", "offset", "drift", "random walk", "step", "periodic"])
 def test_local_prefixes_err_within_their_certified_bound(name, dtype):
     """Every value of a plain local prefix (against Fractions) is within
-    :func:`prefix_error_bound`, and the sum of squares of the differences built from three
-    of them is within the bound :func:`certified` derives from
-    :func:`difference_error_bound`. Noise is certified, also on a large offset (the
-    prefixes are of the centred samples); a period dividing ``m`` far above the noise is
-    not (``D`` is then only the noise), so such pieces take the once-rounded steps."""
+    :func:`prefix_error_bound`, and each level's sum of squares of the differences built from
+    three of them, three levels in one fused pass (m, 2m, 4m: five prefixes), is within the
+    bound :func:`certified` derives from :func:`difference_error_bound`. Noise is certified,
+    also on a large offset (the prefixes are of the centred samples); a period dividing ``m``
+    far above the noise is not (``D`` is then only the noise), so such pieces take the
+    once-rounded steps."""
     from avar._kernels.allan.blocks import CERTIFY_TOL, certified
-    from avar._kernels.allan.far import difference_error_bound, local_prefix, prefix_error_bound, prefix_squares
+    from avar._kernels.allan.far import difference_error_bound, local_prefix, prefix_error_bound
+    from avar._kernels.allan.far_squares import fused_squares
 
-    n, m, t0, count = 3000, 512, 123, 500
+    n, m, t0, count = 3000, 256, 123, 500
     rng = np.random.default_rng(6)
     if name == "white":
         base = rng.standard_normal(n)
@@ -283,38 +285,71 @@ def test_local_prefixes_err_within_their_certified_bound(name, dtype):
     centre = float(np.mean(x.astype(np.float64)))
     v = [Fraction(float(a)) for a in x]
     c = Fraction(centre)
-    prefixes, errors, bigs = [], 0.0, 0.0
-    for j in range(3):
+    offsets = (0, 1, 2, 4, 8)  # the fused pass's prefixes, in units of m
+    ring = np.full(len(offsets) * (count + 1), np.nan)
+    errors, bigs = {}, {}
+    for k, j in enumerate(offsets):
         start = t0 + j * m
-        out = np.full(count + 1, np.nan)
-        big = local_prefix(x[None, :], 0, start, count, centre, 1.0, out)
+        out = ring[k * (count + 1) : (k + 1) * (count + 1)]
+        bigs[j] = local_prefix(x[None, :], 0, start, count, centre, 1.0, out, start)
         spread = float(np.max(np.abs(x[start : start + count].astype(np.float64) - centre)))
-        bound = prefix_error_bound(count, spread, big)
+        errors[j] = prefix_error_bound(count, spread, bigs[j])
         exact_prefix = Fraction(0)
         for i in range(count + 1):
-            assert abs(Fraction(float(out[i])) - exact_prefix) <= bound, (j, i)
+            assert abs(Fraction(float(out[i])) - exact_prefix) <= errors[j], (j, i)
             exact_prefix += v[start + i] - c if i < count else 0
-        prefixes.append(out)
-        errors += (2.0 if j == 1 else 1.0) * bound
-        bigs += (2.0 if j == 1 else 1.0) * big
-    s = [sum(v[: t0 + j * m], Fraction(0)) - (t0 + j * m) * c for j in range(3)]
-    d0 = s[2] - 2 * s[1] + s[0]
-    base_hi = float(d0)
-    base_lo = float(d0 - Fraction(base_hi))
-    total = prefix_squares(prefixes[0], prefixes[1], prefixes[2], base_hi, base_lo, count)
-    want = sum((d0 + Fraction(float(prefixes[2][i])) - 2 * Fraction(float(prefixes[1][i]))
-                + Fraction(float(prefixes[0][i]))) ** 2 for i in range(count))
-    steps = [v[t0 + i + 2 * m] - 2 * v[t0 + i + m] + v[t0 + i] for i in range(count)]
-    d, exact_total = d0, Fraction(0)
-    for i in range(count):
-        exact_total += d * d
-        d += steps[i]
-    delta = difference_error_bound(errors, bigs, base_hi, base_lo, 0.0)
-    bound = 2.0 * delta * np.sqrt(count * total) + count * delta**2 + 2 * count * 2.0**-53 * total
-    assert abs(float(exact_total) - total) <= bound
-    assert abs(float(want) - total) <= 2 * count * 2.0**-53 * total  # the sum itself: plain rounding only
-    if dtype == np.float64 and name in ("white", "offset", "periodic"):
-        assert certified(total, delta, count, CERTIFY_TOL) == (name != "periodic")
+    s = {j: sum(v[: t0 + j * m], Fraction(0)) - (t0 + j * m) * c for j in offsets}
+    pairs = [(float(d), float(d - Fraction(float(d)))) for d in (s[2 * h] - 2 * s[h] + s[0] for h in (1, 2, 4))]
+    bases = np.array([hi + lo for hi, lo in pairs])
+    slots = np.arange(len(offsets)) * (count + 1)
+    totals = np.full(3, np.nan)
+    fused_squares(ring, slots, bases, 3, count, totals)
+    single = np.full(1, np.nan)
+    fused_squares(ring, slots, bases, 1, count, single)
+    assert single[0] == pytest.approx(totals[0], rel=4 * count * 2.0**-53)  # one level alone: the same sum
+    for w, h in enumerate((1, 2, 4)):
+        d = s[2 * h] - 2 * s[h] + s[0]
+        exact_total = Fraction(0)
+        for i in range(count):
+            exact_total += d * d
+            d += v[t0 + i + 2 * h * m] - 2 * v[t0 + i + h * m] + v[t0 + i]
+        delta = difference_error_bound(errors[0] + 2 * errors[h] + errors[2 * h], bigs[0] + 2 * bigs[h] + bigs[2 * h],
+                                       pairs[w][0], pairs[w][1], 0.0)
+        total = totals[w]
+        bound = 2.0 * delta * np.sqrt(count * total) + count * delta**2 + 2 * count * 2.0**-53 * total
+        assert abs(float(exact_total) - total) <= bound, w
+        if dtype == np.float64 and name in ("white", "offset", "periodic"):
+            assert certified(total, delta, count, CERTIFY_TOL) == (name != "periodic"), w
+
+
+@pytest.mark.parametrize("width", range(1, 5))
+def test_fused_squares_sum_each_level_of_the_pass(width):
+    """Each of a fused pass's levels against its own plain sum: level ``w`` reads prefixes
+    ``0``, ``w + 1`` and ``w + 2`` of the pass (the pieces at ``t``, ``t + 2**w m``, ``t + 2**(w+1) m``)."""
+    from avar._kernels.allan.far_squares import fused_squares
+
+    count, stride = 777, 800
+    rng = np.random.default_rng(width)
+    ring = rng.standard_normal(10 * stride) * 1e3
+    slots = rng.permutation(10)[: width + 2] * stride
+    bases = rng.standard_normal(8) * 1e4
+    out = np.full(8, np.nan)
+    fused_squares(ring, slots, bases, width, count, out)
+    p = [ring[slot : slot + count] for slot in slots]
+    want = [np.sum((bases[w] + (p[w + 2] - 2.0 * p[w + 1] + p[0])) ** 2) for w in range(width)]
+    np.testing.assert_allclose(out[:width], want, rtol=1e-12)
+    assert np.isnan(out[width:]).all()  # nothing written beyond the pass's levels
+
+
+def test_far_levels_fused_four_at_a_time_end_to_end():
+    """Ten far levels in one group (tiny pieces, a wide span): passes of four, four and two
+    levels where every level has a full piece, shorter ones near the end of the series, against
+    the loop."""
+    n = 70_000
+    x = adversarial(n)["random walk"]
+    factors = 2 ** np.arange(0, 16, dtype=np.int64)  # 1 .. 32768; far from 64
+    got = run(x, factors, "mo", block=64, near=64, chunk=3, fine=16, span=1024)[0]
+    np.testing.assert_allclose(got, [allan_mo_loop(x, m) for m in factors], rtol=1e-11)
 
 
 def test_second_differences_scale_extreme_samples_before_rounding():

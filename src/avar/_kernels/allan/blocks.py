@@ -131,8 +131,12 @@ def _centred_overload(x, c, sc):
     return impl
 
 
-#: Samples summed per parallel task of :func:`block_table` (whole blocks).
+#: Samples summed per parallel task of :func:`block_table` (whole blocks), at least.
 TABLE_TASK = 1 << 16
+
+#: At most this many tasks per column in :func:`block_table` (longer tasks beyond): their sums
+#: are added in a Python loop, ~10 us a task (at N = 1e8 and 1526 tasks, 15 of its 40 ms).
+TABLE_TASKS = 256
 
 
 @njit(cache=True, nogil=True)
@@ -166,7 +170,7 @@ def block_table(data, scale, integral, block=BLOCK):
     """
     n, channels = data.shape
     nb = -(-n // block)
-    per_task = max(1, TABLE_TASK // block)
+    per_task = max(1, TABLE_TASK // block, -(-nb // TABLE_TASKS))  # a function of N: the bits do not depend on threads
     n_tasks = -(-nb // per_task)
     ph, pl, low, high = (np.empty((channels, nb)) for _ in range(4))
 
@@ -189,7 +193,7 @@ def block_table(data, scale, integral, block=BLOCK):
                                                        pl[:, last])
         task_of = np.arange(nb) // per_task
         table_hi, table_lo = np.zeros((channels, nb + 1)), np.zeros((channels, nb + 1))
-        table_hi[:, 1:], table_lo[:, 1:] = _dd_add(before[0][:, task_of], before[1][:, task_of], ph, pl)
+        _dd_add(before[0][:, task_of], before[1][:, task_of], ph, pl, out_hi=table_hi[:, 1:], out_lo=table_lo[:, 1:])
         centre = (table_hi[:, nb] + table_lo[:, nb]) / n
         if integral:
             centre = np.round(centre)
@@ -199,28 +203,45 @@ def block_table(data, scale, integral, block=BLOCK):
     return BlockTable(table_hi, table_lo, centre, maxabs, spread)
 
 
-def _dd_add(ah, al, bh, bl):
+def _dd_add(ah, al, bh, bl, out_hi=None, out_lo=None):
     """``(ah + al) + (bh + bl)`` as a renormalized pair (elementwise): TwoSum of the high
-    parts, then the low parts and the error added."""
-    s = ah + bh
-    bv = s - ah
-    e = ((ah - (s - bv)) + (bh - bv)) + (al + bl)
-    h = s + e
-    return h, e - (h - s)
+    parts, then the low parts and the error added; written to ``out_hi, out_lo`` when given
+    (they may be ``ah, al``).
+
+    Three temporaries, operations in place: a fresh page costs about a microsecond, and at
+    N = 1e8 (tables of 1e5 entries) the expression form's ten temporaries took 5 ms a call.
+    """
+    s = np.add(ah, bh)
+    bv = np.subtract(s, ah)
+    e = np.subtract(s, bv)
+    np.subtract(ah, e, out=e)  # ah - (s - bv)
+    np.subtract(bh, bv, out=bv)
+    np.add(e, bv, out=e)
+    np.add(al, bl, out=bv)
+    np.add(e, bv, out=e)  # ((ah - (s - bv)) + (bh - bv)) + (al + bl)
+    h = np.add(s, e, out=out_hi)
+    np.subtract(h, s, out=s)
+    return h, np.subtract(e, s, out=out_lo)  # e - (h - s)
 
 
 def _less_centre(th, tl, centre, block, n):
-    """``S[k block] - min(k block, N) * centre`` exactly (Dekker's product), as pairs."""
+    """``S[k block] - min(k block, N) * centre`` exactly (Dekker's product), as pairs, in place."""
     big = centre * 134217729.0  # Dekker split of the centre for exact products p * centre
     c_hi = big - (big - centre)
     c_lo = centre - c_hi
     p = np.minimum(np.arange(th.shape[1]) * block, n).astype(np.float64)
-    ph = p * centre
     bp = p * 134217729.0  # p < 2**53 is split the same way
     p_hi = bp - (bp - p)
-    p_lo = p - p_hi
-    pe = ((p_hi * c_hi - ph) + p_hi * c_lo + p_lo * c_hi) + p_lo * c_lo  # the exact error of p * centre
-    return _dd_add(th, tl, -ph, -pe)
+    p_lo = np.subtract(p, p_hi, out=bp)
+    minus_ph = np.multiply(p, centre)
+    np.negative(minus_ph, out=minus_ph)
+    minus_pe = np.multiply(p_hi, c_hi)  # -(the exact error of p * centre), term by term:
+    np.add(minus_pe, minus_ph, out=minus_pe)  # ((p_hi c_hi - ph) + p_hi c_lo + p_lo c_hi) + p_lo c_lo
+    minus_pe += p_hi * c_lo
+    minus_pe += p_lo * c_hi
+    minus_pe += p_lo * c_lo
+    np.negative(minus_pe, out=minus_pe)
+    return _dd_add(th, tl, minus_ph, minus_pe, out_hi=th, out_lo=tl)
 
 
 @njit(cache=True, inline="always")
@@ -317,9 +338,8 @@ CERTIFY_TOL = 1e-11
 def prefix_squares(p0, p1, p2, base_hi, base_lo, count):
     """Sum over ``i < count`` of ``D_i**2``, ``D_i = base + (p2[i] - 2 p1[i] + p0[i])`` (vectorized).
 
-    Any association of the six terms is allowed (``reassoc``): the callers' error bounds
-    (:func:`avar._kernels.allan.far.difference_error_bound`, :func:`certified_squares`) hold for
-    every one of them.
+    Any association of the six terms is allowed (``reassoc``): the caller's error bound
+    (:func:`certified_squares`, through :func:`plain_squares`) holds for every one of them.
     """
     a = p0[:count]
     b = p1[:count]

@@ -46,8 +46,10 @@ PYRAMID_BLOCK = 1 << 15
 
 #: Levels below this cluster size are the pyramid's (a power of two); the others are
 #: :mod:`avar._kernels.allan.far`'s. Buffers of ``PYRAMID_BLOCK + PYRAMID_NEAR`` float64,
-#: two per task: 640 kB, in a core's L2.
-PYRAMID_NEAR = 1 << 13
+#: two per task: 576 kB, in a core's L2. (At 2**13, the pyramid's thirteenth level took a
+#: pass of its own over a halo twice as long: octave "mo" of 1e8 float32 samples took 5 %
+#: more time than with that level among the far ones, summed four levels a pass.)
+PYRAMID_NEAR = 1 << 12
 
 #: Blocks per parallel task (fixes the summation order).
 PYRAMID_CHUNK = 8
