@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from avar._kernels.total import split_numpy
 from avar._kernels.total import theo1 as theo_levels
 from avar._kernels.total.fft import autocorrelation, short_autocorrelation
 from avar._kernels.total.split import crossing_terms, groups, knot_profile, split_record
@@ -90,6 +91,52 @@ def test_crossing_terms_equal_their_definition(allan):
     np.testing.assert_allclose(cross, plain[:, 0], rtol=1e-12)
     np.testing.assert_allclose(square, plain[:, 1], rtol=1e-13)
     assert np.all(magnitude >= np.abs(cross))
+
+
+@pytest.mark.parametrize("name", ["white PM", "flicker FM", "random-walk FM", "offset and drift"])
+def test_split_kernels_twins_are_the_kernels_bit_for_bit(name):
+    """The NumPy twins a cold process takes (:mod:`avar._kernels.total.split_numpy`) give the
+    kernels' bits: the rest and kinks, the knot profile, and X, G and the size of X's terms of
+    Theo1 and of the overlapping Allan sums."""
+    x = noises(2001)[name]
+    for spacing in (2, 7, 64, 500, 1000):
+        r, knots, kinks = split_record(x, spacing)
+        twin = split_numpy.split_record(x, spacing)
+        assert np.array_equal(twin.rest, r) and np.array_equal(twin.knots, knots) and np.array_equal(twin.kinks, kinks)
+        profile = knot_profile(r, knots, kinks, spacing)
+        assert np.array_equal(split_numpy.knot_profile(r, knots, kinks, spacing), profile)
+        factors = np.unique([m for m in (2, 4, 6, spacing // 3 * 2, spacing - spacing % 2) if 2 <= m <= spacing])
+        for allan in (False, True):
+            want = crossing_terms(profile, spacing, float(kinks @ kinks), factors, allan)
+            got = split_numpy.crossing_terms(profile, spacing, float(kinks @ kinks), factors, allan)
+            for kernel, numpy_twin in zip(want, got):
+                assert np.array_equal(numpy_twin, kernel), (spacing, allan)
+
+
+def test_a_cold_theo1_of_random_walk_fm_sums_as_the_warm_one():
+    """Random-walk FM: the long levels' expansion is ill-conditioned, so they take the split; cold,
+    every split kernel's twin answers, to the warm path's bits, and both equal the direct sums."""
+    from avar._kernels.runtime.paths import forced
+    from avar.stability.total import small
+
+    n = 20_000
+    x = noises(n)["random-walk FM"]
+    factors = np.array([2, 512, 640, 800, 4096])
+    long = (n - factors) * (factors // 2) > theo_levels.DIRECT_TERMS
+    prepared = theo_levels.prepare(x, int(factors.max()) // 2)
+    whole = np.array([theo_levels.theo1_expanded(prepared, int(m)).ratio if far else 0.0
+                      for m, far in zip(factors.tolist(), long)])
+    retry = whole > theo_levels.MAX_RATIO  # the levels theo1_sums gives to the split
+    split = theo_levels.split_sums(x, factors[retry], theo_levels.SPLIT_REACH)
+    by_split = retry.copy()
+    by_split[retry] = split.theo1_ratios <= theo_levels.MAX_RATIO
+    assert by_split.sum() >= 2  # (the split does take some of these levels)
+    with forced("numpy"):
+        cold = theo_levels.theo1_sums(x, factors, small.theo1_direct(NO_GAPS, 0))
+    with forced("compiled"):
+        warm = theo_levels.theo1_sums(x, factors, small.theo1_direct(NO_GAPS, 0))
+    assert np.array_equal(cold.sums[by_split], warm.sums[by_split])
+    np.testing.assert_allclose(cold.sums, [theo1_sum(x, int(m), NO_GAPS, 0).total for m in factors], rtol=1e-9)
 
 
 def test_the_split_is_exact():

@@ -5,6 +5,7 @@ import pytest
 
 import avar
 from avar._kernels.runtime.paths import forced
+from avar._kernels.total.theo1 import SplitSums
 from avar._kernels.total.theobr import oavar_sums
 from avar._kernels.total.windows import theo1_sum
 from avar.stability.total import small_theobr, theobr
@@ -63,9 +64,10 @@ def test_kf_twin_equals_kernels_and_definition(name):
 
 
 def test_ill_conditioned_kf_sums_directly_or_falls_back_to_the_kernels(monkeypatch):
-    """A phase far from zero: the expanded sums cancel. The twin sums the levels that need it
-    directly while that is cheap (its terms then match the definition); beyond its budget of
-    direct terms it declines, and the kernels' kf is used."""
+    """A phase far from zero: the expanded sums cancel. The twin redoes the levels that need it,
+    by the split expansion (its loops' twins) and then directly while that is cheap (its terms
+    then match the definition); when direct terms remain beyond its budget it declines, and the
+    kernels' kf is used."""
     x = np.cumsum(WHITE[:600]) + 1e9
     terms = theobr.twin_terms(x)
     no_gaps = np.zeros(0, dtype=np.int64)
@@ -78,9 +80,38 @@ def test_ill_conditioned_kf_sums_directly_or_falls_back_to_the_kernels(monkeypat
         kf_kernel = theobr.theobr_factor(x)
     with forced("numpy"):
         assert theobr.theobr_factor(x).kf == pytest.approx(kf_kernel.kf, rel=theobr.KF_TOLERANCE)
-        monkeypatch.setattr(small_theobr, "TWIN_DIRECT_TERMS", 0)
+
+    def no_help(x, factors, reach, allan=None, every=None):  # a split that conditions nothing
+        allan = np.zeros(0) if allan is None else allan
+        return SplitSums(np.zeros(len(factors)), np.full(len(factors), np.inf), np.zeros(len(allan)),
+                         np.full(len(allan), np.inf))
+
+    monkeypatch.setattr(theobr, "split_sums", no_help)
+    monkeypatch.setattr(small_theobr, "TWIN_DIRECT_TERMS", 0)
+    with forced("compiled"):
+        kf_kernel = theobr.theobr_factor(x)
+    with forced("numpy"):
         assert theobr.twin_terms(x) is None
         assert theobr.theobr_factor(x) == kf_kernel
+
+
+def test_kf_of_random_walk_fm_takes_the_split_cold():
+    """Random-walk FM at 6e4 points: about 70 Theo1 levels are too ill-conditioned for the expansion
+    and too many terms to sum directly; the twin splits them (the split's loops' twins) as the
+    kernels do, within kf's tolerance of the kernels' kf."""
+    x = _detrended(np.cumsum(np.cumsum(np.random.default_rng(7).standard_normal(60_000))))
+    terms = theobr.twin_terms(x)
+    assert terms is not None
+    kernel, _ = theobr.theobr_terms(x)
+    # each path redoes a sum only as far as kf, their mean, needs: the smallest levels' terms keep
+    # ~1e-7 of the expansion's error in both (measured against the direct sums), kf ~1e-11
+    np.testing.assert_allclose(terms, kernel, rtol=1e-6, atol=0)
+    assert terms.mean() == pytest.approx(kernel.mean(), rel=theobr.KF_TOLERANCE)
+    with forced("numpy"):
+        kf_twin = theobr.theobr_factor(x)
+    with forced("compiled"):
+        kf_kernel = theobr.theobr_factor(x)
+    assert kf_twin.kf == pytest.approx(kf_kernel.kf, rel=theobr.KF_TOLERANCE)
 
 
 def test_triangle_products_follow_their_definitions():

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import avar
+from avar._kernels.runtime.paths import forced
 from avar._kernels.total.fft import autocorrelation
 from avar._kernels.total.theobr import lag_diagonals, oavar_expanded, oavar_sums, theo1_every
 from avar._kernels.total.windows import htot_sum, mtot_sum, theo1_sum
@@ -456,15 +457,19 @@ def test_theobr_factor_of_random_walk_fm_redoes_only_the_levels_kf_needs(monkeyp
         return theo1_sum(x, m, bad, shift)
 
     monkeypatch.setattr(theo, "theo1_sum", counted)
-    kf_default, n = theo.theobr_factor(x)
-    monkeypatch.setattr(theo, "KF_TOLERANCE", 1e-12)  # at N = 6000 the default needs no direct sum
-    calls.clear()
-    kf, n = theo.theobr_factor(x)
+    with forced("compiled"):  # (the kernels' path: the NumPy twin sums directly with NumPy's own loops)
+        kf_default, n = theo.theobr_factor(x)
+        monkeypatch.setattr(theo, "KF_TOLERANCE", 1e-12)  # at N = 6000 the default needs no direct sum
+        calls.clear()
+        kf, n = theo.theobr_factor(x)
+    with forced("numpy"):
+        kf_twin, _ = theo.theobr_factor(x)
     direct = np.mean([oavar_sums(x, np.array([9 + 3 * i]))[0] / (2 * (9 + 3 * i) ** 2 * (x.size - 2 * (9 + 3 * i)))
                       / (theo1_sum(x, 12 + 4 * i, NO_GAPS, 0)[0] / (0.75 * (x.size - 12 - 4 * i) * (12 + 4 * i) ** 2))
                       for i in range(n + 1)])
     assert kf_default == pytest.approx(direct, rel=1e-8)
     assert kf == pytest.approx(direct, rel=1e-11)
+    assert kf_twin == pytest.approx(direct, rel=1e-11)
     assert 0 < len(calls) < n + 1 and 12 + 4 * n not in calls  # the worst conditioned: small factors
 
 

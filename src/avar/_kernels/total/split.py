@@ -41,6 +41,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from avar._kernels.runtime.paths import numpy_path
+from avar._kernels.total import split_numpy
+
 
 class ExpandedSums(NamedTuple):
     """Double sums computed by an expansion, and each one's ratio of the expansion's largest terms
@@ -175,11 +178,22 @@ def crossing_terms(profile: np.ndarray, reach: int, kink_square: float, factors:
     return cross, square, magnitude
 
 
+#: The compiled loops of :func:`split_parts` and of :func:`combine` (while they are cold, their
+#: NumPy twins answer: :mod:`avar._kernels.total.split_numpy`), and their routes for
+#: :func:`avar._kernels.runtime.paths.numpy_path` (found compiled once, never asked again).
+SPLIT_KERNELS = (split_record, knot_profile)
+CROSSING_KERNELS = (crossing_terms,)
+_SPLIT_ROUTE = "total.split_parts"
+_CROSSING_ROUTE = "total.crossing_terms"
+
+
 def split_parts(x: np.ndarray, spacing: int) -> SplitParts:
     """r of :func:`split_record` at knot spacing K = ``spacing``, the profile P (reach K) and
     sum_k beta_k^2: all that the levels m <= K share."""
-    r, knots, kinks = split_record(x, int(spacing))
-    return SplitParts(r, knot_profile(r, knots, kinks, int(spacing)), float(kinks @ kinks))
+    cold = numpy_path(x.shape[0], split_numpy.SPLIT_LIMIT, SPLIT_KERNELS, route=_SPLIT_ROUTE)
+    record, profile = (split_numpy.split_record, split_numpy.knot_profile) if cold else (split_record, knot_profile)
+    r, knots, kinks = record(x, int(spacing))
+    return SplitParts(r, profile(r, knots, kinks, int(spacing)), float(kinks @ kinks))
 
 
 def combine(rest: np.ndarray, rest_ratio: np.ndarray, parts: SplitParts, spacing: int, factors: np.ndarray,
@@ -187,8 +201,11 @@ def combine(rest: np.ndarray, rest_ratio: np.ndarray, parts: SplitParts, spacing
     """S(x) = S(r) + 2 X + G at ``factors`` (each <= ``spacing``) from S(r) (``rest``) and its ratio,
     and the ratio of the largest terms to S(x): ratio(r) S(r) + 2 |X's terms| + G, over S(x).
     ``allan``: the overlapping Allan sums at ``factors`` / 2 instead (:func:`crossing_terms`)."""
-    cross, square, magnitude = crossing_terms(parts.profile, int(spacing), parts.kink_square,
-                                              np.ascontiguousarray(factors, dtype=np.int64), bool(allan))
+    factors = np.ascontiguousarray(factors, dtype=np.int64)
+    spikes = 4 * len(factors) if allan else 8 * int(np.sum(factors))  # 16 per a <= m / 2 of each level
+    cold = numpy_path(spikes, split_numpy.CROSSING_LIMIT, CROSSING_KERNELS, route=_CROSSING_ROUTE)
+    cross, square, magnitude = (split_numpy.crossing_terms if cold else crossing_terms)(
+        parts.profile, int(spacing), parts.kink_square, factors, bool(allan))
     total = rest + 2.0 * cross + square
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         terms = rest_ratio * np.abs(rest) + 2.0 * magnitude + square

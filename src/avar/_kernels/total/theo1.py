@@ -156,7 +156,7 @@ def theo1_expanded(prepared: tuple, m: int) -> Expanded:
 
 
 def split_sums(x: np.ndarray, factors: np.ndarray, reach: float,
-               allan: np.ndarray | None = None) -> SplitSums:
+               allan: np.ndarray | None = None, every=theo1_every) -> SplitSums:
     """Theo1's double sums at the even ``factors`` by the broken-line split of
     :mod:`avar._kernels.total.split` and each one's ratio (as :func:`theo1_expanded`), then the
     overlapping Allan sums at the factors ``allan`` (span 2m; none by default) and their ratios
@@ -165,7 +165,9 @@ def split_sums(x: np.ndarray, factors: np.ndarray, reach: float,
     The spans go in groups (:func:`avar._kernels.total.split.groups`): one split per group, its
     knot spacing the group's largest span, S(r) by :func:`theo1_expanded` per level or, for
     :data:`EVERY_LEVELS` Theo1 levels or more, by :func:`avar._kernels.total.theobr.theo1_every`; F of r
-    only up to the spacing (:func:`avar._kernels.total.fft.short_autocorrelation`)."""
+    only up to the spacing (:func:`avar._kernels.total.fft.short_autocorrelation`). ``every``: the
+    function of :func:`~avar._kernels.total.theobr.theo1_every`'s signature that sums a group's levels
+    at once (a NumPy twin's, while the kernels are cold)."""
     factors = np.asarray(factors, dtype=np.int64)
     allan = np.zeros(0, dtype=np.int64) if allan is None else np.asarray(allan, dtype=np.int64)
     spans = np.concatenate((factors, 2 * allan))
@@ -180,8 +182,8 @@ def split_sums(x: np.ndarray, factors: np.ndarray, reach: float,
         if theo.size >= EVERY_LEVELS or pairs.size:
             diagonals = lag_diagonals(r, np.ascontiguousarray(r[::-1]), spacing // 2 + 1)
         if theo.size >= EVERY_LEVELS:
-            every = theo1_every(r, spacing, autocorr, diagonals)
-            rest, rest_ratio = every.sums[spans[theo]], every.ratios[spans[theo]]
+            every_level = every(r, spacing, autocorr, diagonals)
+            rest, rest_ratio = every_level.sums[spans[theo]], every_level.ratios[spans[theo]]
         elif theo.size:
             prepared = prepare(r, spacing // 2, autocorr)
             rest, rest_ratio = np.array([theo1_expanded(prepared, int(m)) for m in spans[theo]]).reshape(-1, 2).T

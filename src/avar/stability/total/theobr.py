@@ -33,6 +33,8 @@ KF_REACH = 16
 #: left about 200 of random-walk FM's 33,331 at N = 1e6 to be summed directly; 1 / 8 none, for the
 #: same cost of splits).
 KF_ALLAN_REACH = 8
+#: No gaps (the phase of kf is gap-free).
+NO_GAPS = np.zeros(0, dtype=np.int64)
 
 
 class TheoBRFactor(NamedTuple):
@@ -80,40 +82,9 @@ def twin_path(n_points: int) -> bool:
 
 
 def twin_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> np.ndarray | None:
-    """:func:`theobr_terms`' terms by the NumPy twin (:mod:`avar.stability.total.small_theobr`).
-
-    The sums too ill-conditioned for kf's tolerance (:func:`_levels_to_redo`, each kind half of
-    it, as :func:`theobr_terms`) are summed directly in NumPy (:func:`avar.stability.total.small.oavar_sums`,
-    :func:`~avar.stability.total.small.theo1_level_sums`: the kernels' last resort) while their
-    terms stay within :data:`~avar.stability.total.small_theobr.TWIN_DIRECT_TERMS`; beyond that
-    (random-walk FM of N ~ 1e5: about 70 Theo1 levels up to m ~ 280, 5e8 terms) the result is
-    None and the kernels sum them again, by the split expansion first."""
-    n_points = x.shape[0]
-    n = theobr_count(n_points)
-    i = np.arange(n + 1, dtype=np.int64)
-    m_avar = 9 + 3 * i
-    m_theo = 12 + 4 * i
-    autocorr = autocorrelation(x) if autocorr is None else autocorr
-    diagonals = small_theobr.lag_diagonals(x, int(m_avar[-1]) + 1)
-    avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
-    avar_norm = 2.0 * m_avar * m_avar * (n_points - 2 * m_avar)
-    every = small_theobr.theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
-    theo_norm = 0.75 * (n_points - m_theo) * m_theo * m_theo
-    sums = every.sums[m_theo]
-    redo = _levels_to_redo(avar_sums / avar_norm / (sums / theo_norm), avar_ratio, 0.5)
-    work = n_points * redo.size
-    if work > small_theobr.TWIN_DIRECT_TERMS:
-        return None
-    if redo.size:
-        avar_sums[redo] = small.oavar_sums(x, m_avar[redo])
-    avar = avar_sums / avar_norm
-    redo = _levels_to_redo(avar / (sums / theo_norm), every.ratios[m_theo], 0.5)
-    work += small.theo1_work(n_points, m_theo[redo])
-    if work > small_theobr.TWIN_DIRECT_TERMS:
-        return None
-    if redo.size:
-        sums[redo] = small.theo1_level_sums(x, m_theo[redo], np.zeros(0, dtype=np.int64), 0).sums
-    return avar / (sums / theo_norm)
+    """:func:`theobr_terms`' terms by the NumPy twin (:mod:`avar.stability.total.small_theobr`), or
+    None where the twin declines (:func:`_kf_terms`)."""
+    return _kf_terms(x, autocorr, twin=True)
 
 
 def theobr_count(n_points: int) -> int:
@@ -134,41 +105,65 @@ def theobr_count(n_points: int) -> int:
 
 
 def theobr_terms(x: np.ndarray, autocorr: np.ndarray | None = None) -> tuple[np.ndarray, int]:
-    """The n + 1 terms AVAR(9 + 3i) / Theo1(12 + 4i) of :func:`theobr_factor`'s mean, and n.
+    """The n + 1 terms AVAR(9 + 3i) / Theo1(12 + 4i) of :func:`theobr_factor`'s mean, and n, by the
+    compiled kernels (:func:`_kf_terms`)."""
+    return _kf_terms(x, autocorr, twin=False), theobr_count(x.shape[0])
 
-    OAVAR and Theo1 sums by FFT (:func:`avar._kernels.total.theobr.oavar_expanded`, :func:`theo1_every`);
-    the ill-conditioned ones by the split expansion (:func:`avar._kernels.total.theo1.split_sums`),
-    each kind as far as half of kf's tolerance needs (see :func:`_levels_to_redo`), and directly
-    if that is not enough either."""
+
+def _kf_terms(x: np.ndarray, autocorr: np.ndarray | None, twin: bool) -> np.ndarray | None:
+    """kf's terms: OAVAR and Theo1 sums by FFT (:func:`avar._kernels.total.theobr.oavar_expanded`,
+    :func:`~avar._kernels.total.theobr.theo1_every`); the ill-conditioned ones by the split expansion
+    (:func:`avar._kernels.total.theo1.split_sums`), each kind as far as half of kf's tolerance needs
+    (see :func:`_levels_to_redo`), and directly if that is not enough either.
+
+    ``twin``: the NumPy twins throughout (:mod:`avar.stability.total.small_theobr`; the split's
+    loops take theirs while cold), the direct sums in NumPy (:func:`avar.stability.total.small.oavar_sums`,
+    :func:`~avar.stability.total.small.theo1_level_sums`) while their terms stay within
+    :data:`~avar.stability.total.small_theobr.TWIN_DIRECT_TERMS`; beyond that the result is None
+    and the kernels sum them again."""
     n_points = x.shape[0]
     n = theobr_count(n_points)
     i = np.arange(n + 1, dtype=np.int64)
     m_avar = 9 + 3 * i
     m_theo = 12 + 4 * i
     autocorr = autocorrelation(x) if autocorr is None else autocorr
-    diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), int(m_avar[-1]) + 1)
+    if twin:
+        diagonals = small_theobr.lag_diagonals(x, int(m_avar[-1]) + 1)
+    else:
+        diagonals = lag_diagonals(x, np.ascontiguousarray(x[::-1]), int(m_avar[-1]) + 1)
+    every_level = small_theobr.theo1_every if twin else theo1_every
     avar_sums, avar_ratio = oavar_expanded(x, m_avar, autocorr, diagonals)
     avar_norm = 2.0 * m_avar * m_avar * (n_points - 2 * m_avar)
-    every = theo1_every(x, int(m_theo[-1]), autocorr, diagonals)
+    every = every_level(x, int(m_theo[-1]), autocorr, diagonals)
     theo_norm = 0.75 * (n_points - m_theo) * m_theo * m_theo
     sums, ratio = every.sums[m_theo], every.ratios[m_theo]
     # each of the two kinds of sums may bring half of kf's tolerance
     redo = _levels_to_redo(avar_sums / avar_norm * theo_norm / sums, avar_ratio, 0.5)
     if redo.size:  # by the split expansion, then directly
-        again = split_sums(x, np.zeros(0), KF_ALLAN_REACH, m_avar[redo])
+        again = split_sums(x, np.zeros(0), KF_ALLAN_REACH, m_avar[redo], every=every_level)
         _take_better(avar_sums, avar_ratio, redo, again.allan, again.allan_ratios)
         redo = redo[np.isin(redo, _levels_to_redo(avar_sums / avar_norm * theo_norm / sums, avar_ratio, 0.5))]
-        avar_sums[redo] = oavar_sums(x, m_avar[redo])
+    work = n_points * redo.size
+    if twin and work > small_theobr.TWIN_DIRECT_TERMS:
+        return None
+    if redo.size:
+        avar_sums[redo] = (small.oavar_sums if twin else oavar_sums)(x, m_avar[redo])
     avar = avar_sums / avar_norm
     split = _levels_to_redo(avar * theo_norm / sums, ratio, 0.5)  # first by the split expansion
     if split.size:
-        again = split_sums(x, m_theo[split], KF_REACH)
+        again = split_sums(x, m_theo[split], KF_REACH, every=every_level)
         _take_better(sums, ratio, split, again.theo1, again.theo1_ratios)
     theo = sums / theo_norm
-    no_gaps = np.zeros(0, dtype=np.int64)
-    for level in _levels_to_redo(avar / theo, ratio, 0.5):
-        theo[level] = theo1_sum(x, int(m_theo[level]), no_gaps, 0).total / theo_norm[level]
-    return avar / theo, n
+    redo = _levels_to_redo(avar / theo, ratio, 0.5)
+    if twin:
+        if work + small.theo1_work(n_points, m_theo[redo]) > small_theobr.TWIN_DIRECT_TERMS:
+            return None
+        if redo.size:
+            theo[redo] = small.theo1_level_sums(x, m_theo[redo], NO_GAPS, 0).sums / theo_norm[redo]
+        return avar / theo
+    for level in redo:
+        theo[level] = theo1_sum(x, int(m_theo[level]), NO_GAPS, 0).total / theo_norm[level]
+    return avar / theo
 
 
 def _take_better(sums: np.ndarray, ratio: np.ndarray, levels: np.ndarray, new: np.ndarray,
