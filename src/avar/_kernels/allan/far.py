@@ -161,8 +161,8 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
     errors = np.empty(ring)
     bigs = np.empty(ring)
     slots = np.empty(FUSED + 2, dtype=np.int64)  # a fused pass's prefixes (offsets in the ring)
-    pairs = np.empty((FUSED, 2))  # its levels' table bases, double-double
-    bases = np.empty(FUSED)  # ... rounded to float64
+    bases = np.empty(FUSED)  # its levels' table bases, rounded to float64
+    deltas = np.empty(FUSED)  # ... and the bounds on their differences' errors
     totals = np.empty(FUSED)
     ready = 0  # class steps whose local prefix is in the ring
     j = 0
@@ -195,22 +195,18 @@ def far_task(rows, col, first, stride, sc, centre, th, tl, spread, factors, nd, 
             slots[0] = (j % ring) * fine
             for w in range(width + 1):
                 slots[w + 1] = ((j + (h << w)) % ring) * fine
-            for w in range(width):
+            s0 = j % ring
+            for w in range(width):  # each level's base and the bound on its differences' errors
                 o = factors[k + w] // fine
                 ch, cl = table_base(th, tl, col, q, q + o, q + 2 * o)
-                pairs[w, 0] = ch
-                pairs[w, 1] = cl
                 bases[w] = ch + cl
-            fused_squares(prefixes, slots, bases, width, cnt, totals)
-            s0 = j % ring
-            for w in range(width):
-                o = factors[k + w] // fine
                 s1, s2 = (j + (h << w)) % ring, (j + (h << (w + 1))) % ring
                 table_mag = abs(th[col, q]) + 2.0 * abs(th[col, q + o]) + abs(th[col, q + 2 * o])
-                delta = difference_error_bound(errors[s0] + 2.0 * errors[s1] + errors[s2],
-                                               bigs[s0] + 2.0 * bigs[s1] + bigs[s2], pairs[w, 0], pairs[w, 1],
-                                               table_mag)
-                if certified(totals[w], delta, cnt, tol):
+                deltas[w] = difference_error_bound(errors[s0] + 2.0 * errors[s1] + errors[s2],
+                                                   bigs[s0] + 2.0 * bigs[s1] + bigs[s2], ch, cl, table_mag)
+            fused_squares(prefixes, slots, bases, width, cnt, totals)
+            for w in range(width):
+                if certified(totals[w], deltas[w], cnt, tol):
                     out_row[k + w] += totals[w]
                 else:
                     marked[q, k + w] = True

@@ -202,7 +202,7 @@ def combine(rest: np.ndarray, rest_ratio: np.ndarray, parts: SplitParts, spacing
     and the ratio of the largest terms to S(x): ratio(r) S(r) + 2 |X's terms| + G, over S(x).
     ``allan``: the overlapping Allan sums at ``factors`` / 2 instead (:func:`crossing_terms`)."""
     factors = np.ascontiguousarray(factors, dtype=np.int64)
-    spikes = 4 * len(factors) if allan else 8 * int(np.sum(factors))  # 16 per a <= m / 2 of each level
+    spikes = (lambda: 4 * len(factors)) if allan else (lambda: 8 * int(np.sum(factors)))  # 16 per a <= m / 2
     cold = numpy_path(spikes, split_numpy.CROSSING_LIMIT, CROSSING_KERNELS, route=_CROSSING_ROUTE)
     cross, square, magnitude = (split_numpy.crossing_terms if cold else crossing_terms)(
         parts.profile, int(spacing), parts.kink_square, factors, bool(allan))
